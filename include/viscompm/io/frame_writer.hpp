@@ -1,0 +1,33 @@
+// Output of DESIGN.md §4: DIR/frame_NNNNN.h5 (one file per frame whatever the rank count,
+// written collectively with parallel HDF5, to a temporary name renamed when complete) and
+// DIR/particles.xdmf, the index ParaView opens.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viscompm/materials/material.hpp"
+#include "viscompm/parallel/communicator.hpp"
+#include "viscompm/particles/particle_set.hpp"
+
+namespace viscompm::io {
+
+struct FrameInfo {
+  int frame = 0;
+  double time = 0.0;
+  std::int64_t step = 0;
+  std::int64_t particle_count = 0;  ///< global; filled by write_frame
+};
+
+std::string frame_file_name(int frame);
+
+/// Writes DIR/frame_NNNNN.h5 collectively. Rows are in rank order; `id` identifies particles.
+/// Returns the frame's info with the global particle count.
+FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
+                      const materials::MaterialList& materials, const parallel::Communicator& comm);
+
+/// Rewrites DIR/particles.xdmf for `frames` (rank 0 only; temporary name, then rename).
+void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& frames);
+
+}  // namespace viscompm::io

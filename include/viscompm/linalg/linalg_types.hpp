@@ -1,0 +1,36 @@
+// The one place that spells the Tpetra template arguments. This Trilinos is instantiated for
+// Scalar = double, LocalOrdinal = int, GlobalOrdinal = long long on the Kokkos Serial node; no
+// other file repeats them. Include only from src/linalg (Trilinos headers are slow to compile).
+#pragma once
+
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Export.hpp>
+#include <Tpetra_FECrsGraph.hpp>
+#include <Tpetra_FECrsMatrix.hpp>
+#include <Tpetra_Import.hpp>
+#include <Tpetra_Map.hpp>
+#include <Tpetra_MultiVector.hpp>
+#include <Tpetra_Operator.hpp>
+#include <Tpetra_Vector.hpp>
+
+namespace viscompm::linalg {
+
+using scalar_type = double;
+using local_ordinal_type = int;
+using global_ordinal_type = long long;
+using node_type = Tpetra::Map<>::node_type;
+
+using map_type = Tpetra::Map<local_ordinal_type, global_ordinal_type, node_type>;
+using import_type = Tpetra::Import<local_ordinal_type, global_ordinal_type, node_type>;
+using export_type = Tpetra::Export<local_ordinal_type, global_ordinal_type, node_type>;
+using multivector_type = Tpetra::MultiVector<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using vector_type = Tpetra::Vector<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using operator_type = Tpetra::Operator<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using crs_graph_type = Tpetra::CrsGraph<local_ordinal_type, global_ordinal_type, node_type>;
+using crs_matrix_type = Tpetra::CrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using fe_graph_type = Tpetra::FECrsGraph<local_ordinal_type, global_ordinal_type, node_type>;
+using fe_matrix_type = Tpetra::FECrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+
+static_assert(std::is_same_v<global_ordinal_type, map_type::global_ordinal_type>);
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,40 @@
+// Solver configurations come from XML files (inputs/solvers/*.xml), never from code: the Krylov
+// method (Belos), its parameters, and the preconditioner (Ifpack2 or MueLu) with its own
+// parameter list. Reading a file validates it; a bad file is bad input (exit code 2).
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace viscompm::linalg {
+
+/// What one linear solve did; one row of solver.csv.
+struct LinearSolveReport {
+  int iterations = 0;
+  double relative_residual = 0.0;  ///< ‖b − A x‖ / ‖b‖, computed after the solve
+  double setup_seconds = 0.0;      ///< preconditioner set-up
+  double solve_seconds = 0.0;      ///< Krylov iterations
+  bool converged = false;
+  std::string preconditioner;      ///< the configuration's label
+};
+
+class SolverConfiguration {
+ public:
+  /// Reads and validates a solver XML file. Throws InputError naming the file and parameter.
+  static SolverConfiguration read(const std::string& file);
+  /// The same from XML text (tests); `origin` names it in messages.
+  static SolverConfiguration from_xml(const std::string& xml, const std::string& origin);
+
+  /// Name written to solver.csv (the file's "Label", else derived from the preconditioner).
+  const std::string& label() const;
+  /// Where the configuration came from.
+  const std::string& origin() const;
+
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::shared_ptr<const Impl> impl_;
+};
+
+}  // namespace viscompm::linalg

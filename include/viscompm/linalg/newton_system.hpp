@@ -1,0 +1,51 @@
+// The Newton matrix H = M + Δt² ∇²Φ assembled from per-cell element matrices into a Tpetra
+// FECrsMatrix (owned and shared rows, zeroed each assembly, shared rows summed into their
+// owners), and its solve with Belos CG and the configured preconditioner. The graph is built
+// once per set of occupied cells and reused while the particles keep the same cells.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "viscompm/implicit/incremental_potential.hpp"
+#include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/linalg/node_space.hpp"
+
+namespace viscompm::linalg {
+
+class NewtonSystem {
+ public:
+  NewtonSystem(const NodeSpace& space, const SolverConfiguration& config);
+  ~NewtonSystem();
+  NewtonSystem(const NewtonSystem&) = delete;
+  NewtonSystem& operator=(const NewtonSystem&) = delete;
+
+  /// Assembles H at grid velocities v (collective); particle Hessians projected to PSD if
+  /// `project`.
+  void assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project);
+  /// Solves H dv = rhs from dv = 0 (rhs: totals on the local nodes, owned entries used); dv is
+  /// returned on all local nodes. Sets up the preconditioner first if H changed.
+  LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv);
+
+  std::int64_t global_rows() const;
+  std::int64_t global_nonzeros() const;
+  /// Seconds spent in the last assemble().
+  double assembly_seconds() const;
+  /// How many times the graph has been built.
+  int graph_builds() const;
+  /// Every entry (global row, global column, value) of H, on every rank, sorted (collective).
+  std::vector<std::tuple<long long, long long, double>> gather_entries() const;
+  /// Writes H to a MatrixMarket file (collective).
+  void write_matrix_market(const std::string& file) const;
+  const SolverConfiguration& configuration() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,35 @@
+// A thin value wrapper around an MPI communicator: rank, size and the few reductions the
+// physics layer needs (global sums of energies, maxima of speeds, agreement on decisions).
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+
+namespace viscompm::parallel {
+
+class Communicator {
+ public:
+  explicit Communicator(MPI_Comm comm = MPI_COMM_WORLD);
+
+  MPI_Comm comm() const { return comm_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool is_root() const { return rank_ == 0; }
+
+  double sum(double local) const;
+  std::int64_t sum(std::int64_t local) const;
+  double max(double local) const;
+  double min(double local) const;
+  std::int64_t max(std::int64_t local) const;
+  /// True on every rank if `local` is true on any rank.
+  bool any(bool local) const;
+  void barrier() const;
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0;
+  int size_ = 1;
+};
+
+}  // namespace viscompm::parallel

@@ -1,0 +1,42 @@
+// Ownership of grid nodes by ranks in spatial blocks: the node index range of each dimension is
+// cut into pieces, and rank (a, b, c) of the process grid owns the block of nodes between its cuts.
+// A particle lives on the rank that owns its cell, the node base + 1 of its stencil.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "viscompm/grid/bspline.hpp"
+#include "viscompm/grid/grid_geometry.hpp"
+
+namespace viscompm::parallel {
+
+class BlockDecomposition {
+ public:
+  /// Splits the nodes of `geometry` among `ranks` ranks: the process grid is the factorisation of
+  /// `ranks` into three factors with the smallest block surface, and cuts are even.
+  BlockDecomposition(const grid::GridGeometry& geometry, int ranks);
+
+  int ranks() const { return ranks_; }
+  const Int3& process_grid() const { return process_grid_; }
+  /// Rank owning node ijk (clamped to the grid).
+  int owner_of_node(const Int3& ijk) const;
+  /// Rank owning a particle whose stencil starts at `stencil_base`.
+  int owner_of_cell(const Int3& stencil_base) const { return owner_of_node(stencil_base + Int3::Ones()); }
+  /// The half-open node range [lower, upper) owned by `rank`.
+  void owned_block(int rank, Int3& lower, Int3& upper) const;
+  /// Cut positions along dimension d: process slice a owns nodes [cuts[a], cuts[a+1]).
+  const std::vector<int>& cuts(int d) const { return cuts_[d]; }
+  /// Replaces the cuts of dimension d (used by rebalancing). Must stay increasing.
+  void set_cuts(int d, std::vector<int> cuts);
+
+ private:
+  int slice_of(int d, int node) const;
+
+  int ranks_;
+  Int3 nodes_;
+  Int3 process_grid_;
+  std::array<std::vector<int>, 3> cuts_;
+};
+
+}  // namespace viscompm::parallel

@@ -1,0 +1,121 @@
+// A scene: a Teuchos XML parameter list (inputs/scenes/*.xml) read into typed structs. Every
+// parameter is declared once (the tables below and each material model's own table); unknown
+// names, wrong types and out-of-range values fail at read time with InputError.
+//
+//   Simulation  frames, frame rate, CFL, Δt bounds, gravity, transfer, kernel
+//   Grid        box, cell size, domain walls
+//   Newton      implicit::NewtonSettings
+//   Solver      the solver XML file
+//   Materials   one sublist per material: "Model" and that model's parameters
+//   Bodies      one sublist per body: shape, material, sampling, initial velocity
+//   Colliders   one sublist per collider: shape, contact type, motion
+//   Output      directory
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "viscompm/core/parameters.hpp"
+#include "viscompm/core/shape.hpp"
+#include "viscompm/implicit/newton.hpp"
+
+namespace viscompm::scene {
+
+struct SimulationSettings {
+  int frames = 24;
+  double frame_rate = 24.0;
+  double cfl = 0.5;
+  double max_time_step = 1e-2;
+  double min_time_step = 1e-7;
+  Vec3 gravity = Vec3(0.0, -9.81, 0.0);
+  std::string transfer = "apic";
+  double flip_ratio = 0.95;
+  std::string kernel = "quadratic";
+  static const ParameterTable<SimulationSettings>& table();
+};
+
+struct GridSettings {
+  Vec3 lower_corner = Vec3::Zero();
+  Vec3 upper_corner = Vec3::Ones();
+  double cell_size = 0.05;
+  std::string walls = "separating";
+  int wall_thickness = 2;
+  static const ParameterTable<GridSettings>& table();
+};
+
+/// The shape parameters bodies and colliders share.
+struct ShapeSettings {
+  std::string shape = "box";
+  Vec3 lower_corner = Vec3::Zero();
+  Vec3 upper_corner = Vec3::Ones();
+  Vec3 center = Vec3::Zero();
+  double radius = 0.1;
+  Vec3 axis = Vec3::UnitY();
+  double length = 1.0;
+  Vec3 normal = Vec3::UnitY();
+};
+
+struct BodySettings : ShapeSettings {
+  std::string name;
+  std::string material;
+  int particles_per_cell = 2;
+  Vec3 velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();
+  static const ParameterTable<BodySettings>& table();
+};
+
+struct ColliderSettings : ShapeSettings {
+  std::string name;
+  std::string contact = "sticky";
+  Vec3 velocity = Vec3::Zero();
+  double start_time = 0.0;
+  double stop_time = 1e30;
+  static const ParameterTable<ColliderSettings>& table();
+};
+
+struct SolverFileSettings {
+  std::string file = "../solvers/jacobi_cg.xml";
+  static const ParameterTable<SolverFileSettings>& table();
+};
+
+struct OutputSettings {
+  std::string directory = "output";
+  static const ParameterTable<OutputSettings>& table();
+};
+
+struct MaterialSettings {
+  std::string name;
+  std::string model;
+  ParameterValues values;  ///< validated against the model's declarations
+};
+
+struct SceneConfig {
+  std::string file;                  ///< where it was read from
+  std::string name;                  ///< the top-level list's name
+  SimulationSettings simulation;
+  GridSettings grid;
+  implicit::NewtonSettings newton;
+  std::string solver_file;           ///< resolved path
+  OutputSettings output;
+  std::vector<MaterialSettings> materials;
+  std::vector<BodySettings> bodies;
+  std::vector<ColliderSettings> colliders;
+};
+
+/// The solid described by shape parameters (already validated by read_scene).
+Shape shape_of(const ShapeSettings& settings);
+
+/// A --set override: "Path/To/Parameter=value".
+struct Override {
+  std::string path;
+  std::string value;
+  static Override parse(const std::string& text);
+};
+
+/// Reads and validates a scene; overrides are applied first (in order). Throws InputError.
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides = {});
+
+/// Documentation of every scene parameter (for --help and doc/).
+std::string describe_scene_parameters();
+
+}  // namespace viscompm::scene

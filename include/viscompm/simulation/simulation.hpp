@@ -1,0 +1,75 @@
+// A run of a scene: set-up (grid, decomposition, materials, particles, colliders), then frames
+// of adaptive time steps (CFL, landing on frame times, Δt halved when Newton fails), output
+// and a progress line per frame on rank 0.
+#pragma once
+
+#include <iosfwd>
+#include <memory>
+
+#include "viscompm/boundary/colliders.hpp"
+#include "viscompm/io/frame_writer.hpp"
+#include "viscompm/io/solver_log.hpp"
+#include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/materials/material.hpp"
+#include "viscompm/parallel/decomposition.hpp"
+#include "viscompm/scene/scene.hpp"
+#include "viscompm/simulation/time_integrator.hpp"
+
+namespace viscompm::simulation {
+
+/// The grid a scene asks for: cells of the given size covering [lower, upper] (rounded up).
+grid::GridGeometry make_grid(const scene::GridSettings& grid);
+materials::MaterialList make_materials(const scene::SceneConfig& scene);
+boundary::Boundary make_boundary(const scene::SceneConfig& scene);
+/// The particles of all bodies that this rank owns (ids independent of the rank count).
+particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
+                                        grid::KernelOrder order, const parallel::BlockDecomposition& decomposition,
+                                        const materials::MaterialList& materials, int rank);
+
+struct RunSummary {
+  std::int64_t steps = 0;
+  std::int64_t newton_iterations = 0;
+  std::int64_t linear_iterations = 0;
+  std::int64_t retries = 0;
+  double wall_seconds = 0.0;
+};
+
+class Simulation {
+ public:
+  Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
+             const parallel::Communicator& comm);
+
+  /// Writes frame 0, then every frame of the scene, logging progress to `log` on rank 0.
+  RunSummary run(std::ostream& log);
+  /// Advances to time t_end with adaptive steps (no output). Throws SimulationError if Newton
+  /// fails at the smallest Δt.
+  void advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr);
+  /// The Δt the next step would try (CFL, bounds), before landing on t_end.
+  double suggested_time_step() const;
+
+  double time() const { return time_; }
+  std::int64_t step_count() const { return step_; }
+  particles::ParticleSet& particles() { return particles_; }
+  const materials::MaterialList& materials() const { return materials_; }
+  TimeIntegrator& integrator() { return *integrator_; }
+  const grid::GridGeometry& grid() const { return geometry_; }
+
+ private:
+  scene::SceneConfig scene_;
+  parallel::Communicator comm_;
+  grid::GridGeometry geometry_;
+  grid::KernelOrder order_;
+  parallel::BlockDecomposition decomposition_;
+  materials::MaterialList materials_;
+  boundary::Boundary boundary_;
+  particles::ParticleSet particles_;
+  std::unique_ptr<TimeIntegrator> integrator_;
+  std::unique_ptr<io::SolverLog> solver_log_;  ///< open during run()
+  double time_ = 0.0;
+  std::int64_t step_ = 0;
+  double time_step_cap_;          ///< halved when Newton fails, grows ×1.5 per success
+  int retries_reported_ = 0;
+  std::vector<io::FrameInfo> frames_;
+};
+
+}  // namespace viscompm::simulation

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs what is missing (Debian packages), configures and builds viscompm into build/.
+# Sourced by scripts/demo.sh and scripts/test.sh; safe to run again when everything is there.
+set -euo pipefail
+
+VISCOMPM_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD_DIR="${VISCOMPM_BUILD_DIR:-$VISCOMPM_ROOT/build}"
+JOBS="${VISCOMPM_JOBS:-$(nproc)}"
+
+packages=(
+  cmake g++ make ccache
+  trilinos-all-dev libptscotch-dev libscotch-dev   # Trilinos' CMake files name scotch by path
+  libopenmpi-dev openmpi-bin
+  libeigen3-dev libhdf5-openmpi-dev
+  libgtest-dev
+  python3 python3-numpy python3-h5py python3-matplotlib
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "viscompm: installing ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# Open MPI refuses to run as root (containers, CI) and more ranks than cores unless told.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+
+cmake -S "$VISCOMPM_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$BUILD_DIR" -j "$JOBS"

@@ -1,0 +1,59 @@
+#include "viscompm/app/run_program.hpp"
+
+#include <Teuchos_DefaultComm.hpp>
+#include <Teuchos_TimeMonitor.hpp>
+#include <iostream>
+
+#include "viscompm/core/error.hpp"
+#include "viscompm/linalg/environment.hpp"
+#include "viscompm/scene/command_line.hpp"
+#include "viscompm/simulation/simulation.hpp"
+
+namespace viscompm::app {
+
+int run_simulation_program(int argc, char** argv) {
+  linalg::Environment environment(&argc, &argv);
+  const parallel::Communicator comm(MPI_COMM_WORLD);
+  const bool root = comm.is_root();
+  try {
+    scene::ProgramOptions options;
+    options.program = "viscompm";
+    options.description =
+        "viscompm: implicit Material Point Method for viscoelastic fluids, foams and sponges (Ram 2015),\n"
+        "with the Newton systems assembled into Tpetra and solved by Belos CG.\n"
+        "Writes DIR/frame_NNNNN.h5, DIR/particles.xdmf and DIR/solver.csv.\n"
+        "Exit codes: 0 success, 2 bad input, 3 the simulation failed.";
+    options.epilogue = "\nScene parameters (sections of SCENE.xml, addressable by --set):\n" +
+                       scene::describe_scene_parameters();
+    const scene::CommandLine cl = scene::parse_command_line(argc, argv, options);
+    if (cl.help) {
+      if (root) std::cout << cl.help_text;
+      return exit_success;
+    }
+    const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
+    const linalg::SolverConfiguration solver =
+        linalg::SolverConfiguration::read(cl.solver_file.empty() ? scene.solver_file : cl.solver_file);
+    if (!cl.restart_file.empty()) throw InputError("--restart: checkpoints are not supported by this build");
+    simulation::Simulation simulation(scene, solver, comm);
+    const simulation::RunSummary summary = simulation.run(std::cout);
+    Teuchos::TimeMonitor::summarize(std::cout, false, true, false, Teuchos::Union, "viscompm:");
+    if (root)
+      std::cout << "done: " << summary.steps << " steps, " << summary.newton_iterations << " Newton iterations, "
+                << summary.linear_iterations << " CG iterations, " << summary.retries << " retries in "
+                << summary.wall_seconds << " s\n"
+                << "output: " << scene.output.directory << "/particles.xdmf (ParaView), frame_*.h5, solver.csv\n";
+    return exit_success;
+  } catch (const InputError& e) {
+    if (root) std::cerr << "viscompm: " << e.what() << std::endl;
+    return exit_bad_input;
+  } catch (const SimulationError& e) {
+    if (root) std::cerr << "viscompm: simulation failed: " << e.what() << std::endl;
+    return exit_simulation_failed;
+  } catch (const std::exception& e) {
+    std::cerr << "viscompm: internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
+    MPI_Abort(MPI_COMM_WORLD, exit_simulation_failed);
+    return exit_simulation_failed;
+  }
+}
+
+}  // namespace viscompm::app

@@ -1,0 +1,68 @@
+#include "viscompm/core/parameters.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "viscompm/core/error.hpp"
+
+namespace viscompm {
+
+namespace {
+std::string number_text(double x) {
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+}  // namespace
+
+std::string ParameterSpec::type_name(Type type) {
+  switch (type) {
+    case Type::real: return "double";
+    case Type::integer: return "int";
+    case Type::boolean: return "bool";
+    case Type::string: return "string";
+    case Type::vector3: return "Array(double)";
+  }
+  return "?";
+}
+
+std::string ParameterSpec::range_text() const {
+  if (type == Type::real || type == Type::integer) {
+    return std::string(min_inclusive ? "[" : "(") + number_text(min) + ", " + number_text(max) +
+           (max_inclusive ? "]" : ")");
+  }
+  if (type == Type::string && !choices.empty()) {
+    std::string text = "one of:";
+    for (std::size_t k = 0; k < choices.size(); ++k) text += (k ? ", " : " ") + choices[k];
+    return text;
+  }
+  if (type == Type::vector3) return "3 numbers";
+  return "any";
+}
+
+std::string ParameterSpec::check(const ParameterValue& value) const {
+  if (type == Type::real || type == Type::integer) {
+    const double x = type == Type::real ? std::get<double>(value) : std::get<int>(value);
+    const bool ok = std::isfinite(x) && (min_inclusive ? x >= min : x > min) &&
+                    (max_inclusive ? x <= max : x < max);
+    if (!ok) return "value " + number_text(x) + " is out of range " + range_text();
+  } else if (type == Type::string && !choices.empty()) {
+    const auto& s = std::get<std::string>(value);
+    for (const auto& c : choices)
+      if (c == s) return {};
+    return "value '" + s + "' is not " + range_text();
+  } else if (type == Type::vector3) {
+    const auto& v = std::get<Vec3>(value);
+    if (!v.allFinite()) return "value has a non-finite component";
+  }
+  return {};
+}
+
+const ParameterValue& ParameterValues::at(const std::string& name) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) throw InputError("missing parameter '" + name + "'");
+  return it->second;
+}
+
+}  // namespace viscompm

@@ -1,0 +1,43 @@
+// Belos CG and the preconditioners of a SolverConfiguration, on Tpetra objects.
+#pragma once
+
+#include <BelosLinearProblem.hpp>
+#include <BelosSolverManager.hpp>
+#include <BelosTpetraAdapter.hpp>
+
+#include "solver_configuration_impl.hpp"
+#include "viscompm/linalg/linalg_types.hpp"
+
+namespace viscompm::linalg {
+
+/// Node data a multigrid preconditioner needs besides the matrix: coordinates of the owned
+/// nodes (one row per node) and the 6 rigid-body modes on the owned dofs.
+struct NearNullspace {
+  Teuchos::RCP<multivector_type> coordinates;
+  Teuchos::RCP<multivector_type> rigid_body_modes;
+};
+
+class Preconditioner {
+ public:
+  virtual ~Preconditioner() = default;
+  /// Builds (pattern_changed) or refreshes the preconditioner for the values of A.
+  virtual void setup(const Teuchos::RCP<crs_matrix_type>& A, bool pattern_changed, const NearNullspace& modes) = 0;
+  /// The operator to apply, null for no preconditioning.
+  virtual Teuchos::RCP<operator_type> op() const = 0;
+};
+
+std::unique_ptr<Preconditioner> make_preconditioner(const SolverConfiguration& config);
+
+class KrylovSolver {
+ public:
+  explicit KrylovSolver(const SolverConfiguration& config);
+  /// Solves A x = b from x = 0. Failures (breakdown, no convergence) are reported, not thrown.
+  LinearSolveReport solve(const Teuchos::RCP<const operator_type>& A, const Teuchos::RCP<operator_type>& M,
+                          multivector_type& x, const multivector_type& b);
+
+ private:
+  SolverConfiguration config_;
+  Teuchos::RCP<Belos::SolverManager<scalar_type, multivector_type, operator_type>> solver_;
+};
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,102 @@
+#include "viscompm/linalg/linear_solver.hpp"
+
+#include <BelosSolverFactory.hpp>
+#include <BelosTpetraAdapter.hpp>
+#include <Ifpack2_Parameters.hpp>
+#include <Teuchos_XMLParameterListCoreHelpers.hpp>
+
+#include "solver_configuration_impl.hpp"
+#include "viscompm/core/error.hpp"
+#include "viscompm/linalg/linalg_types.hpp"
+#include "viscompm/scene/parameter_io.hpp"
+
+namespace viscompm::linalg {
+
+const ParameterTable<SolverSettings>& SolverSettings::table() {
+  static const ParameterTable<SolverSettings> t = [] {
+    ParameterTable<SolverSettings> table;
+    using S = SolverSettings;
+    table.string(&S::label, "Label", "", {}, "name of this configuration in solver.csv and study.csv")
+        .string(&S::krylov_solver, "Krylov solver", "Pseudo Block CG", {"Pseudo Block CG", "Block CG"},
+                "Belos solver (Pseudo Block CG is Belos' CG)")
+        .string(&S::preconditioner, "Preconditioner", "Ifpack2", {"none", "Ifpack2", "MueLu"},
+                "preconditioner package")
+        .string(&S::ifpack2_type, "Ifpack2 type", "RELAXATION", {}, "Ifpack2::Factory name (RELAXATION, CHEBYSHEV, ...)");
+    return table;
+  }();
+  return t;
+}
+
+namespace {
+constexpr const char* krylov_sublist = "Krylov parameters";
+constexpr const char* preconditioner_sublist = "Preconditioner parameters";
+
+// Every key of `given` must be a key of `valid` (Teuchos' own lists of valid parameters).
+void check_known(const Teuchos::ParameterList& given, const Teuchos::ParameterList& valid,
+                 const std::string& file, const std::string& path) {
+  std::vector<std::string> names;
+  for (auto it = valid.begin(); it != valid.end(); ++it) names.push_back(valid.name(it));
+  for (auto it = given.begin(); it != given.end(); ++it) {
+    const std::string& name = given.name(it);
+    if (valid.isParameter(name)) continue;
+    std::string reason = "unknown parameter";
+    const std::string hint = scene::closest_name(name, names);
+    if (!hint.empty()) reason += " (did you mean '" + hint + "'?)";
+    throw InputError(file + ": parameter '" + path + "/" + name + "': " + reason);
+  }
+}
+
+std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& list, const std::string& origin) {
+  auto impl = std::make_shared<SolverConfiguration::Impl>();
+  impl->origin = origin;
+  const ParameterValues values =
+      scene::read_parameters(list, SolverSettings::table().specs(), origin, "", {krylov_sublist, preconditioner_sublist});
+  impl->settings = SolverSettings::table().parse(values);
+  SolverSettings& s = impl->settings;
+
+  impl->krylov_parameters = Teuchos::rcp(new Teuchos::ParameterList(
+      list.isSublist(krylov_sublist) ? list.sublist(krylov_sublist) : Teuchos::ParameterList()));
+  impl->preconditioner_parameters = Teuchos::rcp(new Teuchos::ParameterList(
+      list.isSublist(preconditioner_sublist) ? list.sublist(preconditioner_sublist) : Teuchos::ParameterList()));
+
+  // Belos knows its parameters: reject misspellings now rather than ignore them later.
+  Belos::SolverFactory<scalar_type, multivector_type, operator_type> factory;
+  auto solver = factory.create(s.krylov_solver, Teuchos::null);
+  check_known(*impl->krylov_parameters, *solver->getValidParameters(), origin, krylov_sublist);
+
+  if (s.preconditioner == "Ifpack2") {
+    Teuchos::ParameterList valid;
+    Ifpack2::getValidParameters(valid);
+    check_known(*impl->preconditioner_parameters, valid, origin, preconditioner_sublist);
+  }
+  if (s.label.empty()) {
+    s.label = s.preconditioner == "Ifpack2" ? "Ifpack2 " + s.ifpack2_type : s.preconditioner;
+    if (impl->preconditioner_parameters->isParameter("relaxation: type"))
+      s.label += " " + impl->preconditioner_parameters->get<std::string>("relaxation: type");
+  }
+  return impl;
+}
+}  // namespace
+
+SolverConfiguration SolverConfiguration::read(const std::string& file) {
+  SolverConfiguration c;
+  c.impl_ = parse(*scene::read_xml_file(file), file);
+  return c;
+}
+
+SolverConfiguration SolverConfiguration::from_xml(const std::string& xml, const std::string& origin) {
+  SolverConfiguration c;
+  Teuchos::RCP<Teuchos::ParameterList> list;
+  try {
+    list = Teuchos::getParametersFromXmlString(xml);
+  } catch (const std::exception& e) {
+    throw InputError(origin + ": not a valid XML parameter list");
+  }
+  c.impl_ = parse(*list, origin);
+  return c;
+}
+
+const std::string& SolverConfiguration::label() const { return impl_->settings.label; }
+const std::string& SolverConfiguration::origin() const { return impl_->origin; }
+
+}  // namespace viscompm::linalg

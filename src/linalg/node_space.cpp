@@ -1,0 +1,135 @@
+#include "viscompm/linalg/node_space.hpp"
+
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_TieBreak.hpp>
+#include <algorithm>
+
+#include "node_space_impl.hpp"
+
+namespace viscompm::linalg {
+
+namespace {
+// Ownership among the ranks that touch a node: the block owner if it is one of them, else the
+// lowest rank.
+class PreferBlockOwner : public Tpetra::Details::TieBreak<local_ordinal_type, global_ordinal_type> {
+ public:
+  PreferBlockOwner(const parallel::BlockDecomposition& d, const grid::GridGeometry& g)
+      : decomposition_(d), geometry_(g) {}
+  bool mayHaveSideEffects() const override { return false; }
+  std::size_t selectedIndex(global_ordinal_type gid,
+                            const std::vector<std::pair<int, local_ordinal_type>>& pid_and_lid) const override {
+    const int block_owner = decomposition_.owner_of_node(geometry_.node_index(gid));
+    std::size_t best = 0;
+    for (std::size_t k = 0; k < pid_and_lid.size(); ++k) {
+      if (pid_and_lid[k].first == block_owner) return k;
+      if (pid_and_lid[k].first < pid_and_lid[best].first) best = k;
+    }
+    return best;
+  }
+
+ private:
+  const parallel::BlockDecomposition& decomposition_;
+  const grid::GridGeometry& geometry_;
+};
+
+Teuchos::RCP<const map_type> make_map(const std::vector<global_ordinal_type>& gids,
+                                      const Teuchos::RCP<const Teuchos::Comm<int>>& comm) {
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  return Teuchos::rcp(new map_type(invalid, Teuchos::ArrayView<const global_ordinal_type>(gids), 0, comm));
+}
+
+std::vector<global_ordinal_type> dof_ids(const std::vector<NodeId>& nodes, std::size_t count) {
+  std::vector<global_ordinal_type> dofs(3 * count);
+  for (std::size_t i = 0; i < count; ++i)
+    for (int d = 0; d < 3; ++d) dofs[3 * i + d] = 3 * nodes[i] + d;
+  return dofs;
+}
+
+// Copies `data` (n rows of `width` values) in and out of a Tpetra multivector through
+// export (ADD into owners) then import (owners to every copy).
+void sum_through(const NodeSpace::Impl& s, double* data, std::size_t rows, bool dofs) {
+  const auto& local_map = dofs ? s.local_dof_map : s.local_node_map;
+  const auto& owned_map = dofs ? s.owned_dof_map : s.owned_node_map;
+  multivector_type local(local_map, 1), owned(owned_map, 1);
+  {
+    auto view = local.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t r = 0; r < rows; ++r) view(r, 0) = data[r];
+  }
+  owned.doExport(local, dofs ? *s.dof_export : *s.node_export, Tpetra::ADD);
+  local.doImport(owned, dofs ? *s.dof_import : *s.node_import, Tpetra::INSERT);
+  auto view = local.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t r = 0; r < rows; ++r) data[r] = view(r, 0);
+}
+}  // namespace
+
+NodeSpace::NodeSpace(const parallel::Communicator& comm) : comm_(comm), impl_(std::make_unique<Impl>()) {
+  impl_->comm = Teuchos::rcp(new Teuchos::MpiComm<int>(comm.comm()));
+}
+
+NodeSpace::~NodeSpace() = default;
+
+bool NodeSpace::update(const std::vector<NodeId>& touched, const parallel::BlockDecomposition& decomposition,
+                       grid::GridLayout& layout) {
+  Impl& s = *impl_;
+  const bool changed = comm_.any(touched != s.touched) || s.version == 0;
+  if (changed) {
+    s.touched = touched;
+    // Among the ranks touching a node, one becomes its owner.
+    const std::vector<global_ordinal_type> touched_gids(touched.begin(), touched.end());
+    const auto touched_map = make_map(touched_gids, s.comm);
+    const PreferBlockOwner tie_break(decomposition, layout.geometry);
+    const auto unique_map = Tpetra::createOneToOne(touched_map, tie_break);
+    std::vector<NodeId> owned(unique_map->getNodeElementList().begin(), unique_map->getNodeElementList().end());
+    std::sort(owned.begin(), owned.end());
+    std::vector<NodeId> shared;
+    std::set_difference(touched.begin(), touched.end(), owned.begin(), owned.end(), std::back_inserter(shared));
+    s.owned_count = owned.size();
+    s.local_nodes = owned;
+    s.local_nodes.insert(s.local_nodes.end(), shared.begin(), shared.end());
+
+    const std::vector<global_ordinal_type> local_gids(s.local_nodes.begin(), s.local_nodes.end());
+    s.owned_node_map = make_map(std::vector<global_ordinal_type>(owned.begin(), owned.end()), s.comm);
+    s.local_node_map = make_map(local_gids, s.comm);
+    s.owned_dof_map = make_map(dof_ids(s.local_nodes, s.owned_count), s.comm);
+    s.local_dof_map = make_map(dof_ids(s.local_nodes, s.local_nodes.size()), s.comm);
+    s.node_export = Teuchos::rcp(new export_type(s.local_node_map, s.owned_node_map));
+    s.dof_export = Teuchos::rcp(new export_type(s.local_dof_map, s.owned_dof_map));
+    s.node_import = Teuchos::rcp(new import_type(s.owned_node_map, s.local_node_map));
+    s.dof_import = Teuchos::rcp(new import_type(s.owned_dof_map, s.local_dof_map));
+    ++s.version;
+  }
+  layout.nodes = s.local_nodes;
+  layout.owned_count = s.owned_count;
+  grid::index_cell_nodes(layout);
+  return changed;
+}
+
+void NodeSpace::accumulate(NodeScalarField& field) const {
+  sum_through(*impl_, field.data(), field.size(), false);
+}
+
+void NodeSpace::accumulate(NodeVectorField& field) const {
+  sum_through(*impl_, field.data()->data(), 3 * field.size(), true);
+}
+
+void NodeSpace::distribute(NodeVectorField& field) const {
+  const Impl& s = *impl_;
+  multivector_type owned(s.owned_dof_map, 1), local(s.local_dof_map, 1);
+  const double* data = field.data()->data();
+  {
+    auto view = owned.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t r = 0; r < 3 * s.owned_count; ++r) view(r, 0) = data[r];
+  }
+  local.doImport(owned, *s.dof_import, Tpetra::INSERT);
+  auto view = local.getLocalViewHost(Tpetra::Access::ReadOnly);
+  double* out = field.data()->data();
+  for (std::size_t r = 0; r < 3 * field.size(); ++r) out[r] = view(r, 0);
+}
+
+std::int64_t NodeSpace::global_node_count() const {
+  return static_cast<std::int64_t>(impl_->owned_node_map->getGlobalNumElements());
+}
+
+std::uint64_t NodeSpace::version() const { return impl_->version; }
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,242 @@
+#include "viscompm/scene/parameter_io.hpp"
+
+#include <Teuchos_Array.hpp>
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Teuchos_XMLParameterListHelpers.hpp>
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include "viscompm/core/error.hpp"
+
+namespace viscompm::scene {
+
+namespace {
+
+std::string joined(const std::string& path, const std::string& name) {
+  return path.empty() ? name : path + "/" + name;
+}
+
+[[noreturn]] void fail(const std::string& file, const std::string& parameter, const std::string& reason) {
+  throw InputError(file + ": parameter '" + parameter + "': " + reason);
+}
+
+std::string teuchos_type_name(const Teuchos::ParameterEntry& entry) {
+  const auto& any = entry.getAny(false);
+  if (any.type() == typeid(double)) return "double";
+  if (any.type() == typeid(int)) return "int";
+  if (any.type() == typeid(bool)) return "bool";
+  if (any.type() == typeid(std::string)) return "string";
+  if (any.type() == typeid(Teuchos::Array<double>)) return "Array(double)";
+  if (any.type() == typeid(Teuchos::Array<int>)) return "Array(int)";
+  return any.typeName();
+}
+
+// A Teuchos validator for one declared parameter: its one-line range check and docs.
+class SpecValidator : public Teuchos::ParameterEntryValidator {
+ public:
+  explicit SpecValidator(ParameterSpec spec) : spec_(std::move(spec)) {}
+  const std::string getXMLTypeName() const override { return "viscompmSpecValidator"; }
+  void printDoc(const std::string& docString, std::ostream& out) const override {
+    out << "# " << docString << "\n# valid: " << spec_.range_text() << "\n";
+  }
+  ValidStringsList validStringValues() const override {
+    if (spec_.choices.empty()) return Teuchos::null;
+    return Teuchos::rcp(new Teuchos::Array<std::string>(spec_.choices.begin(), spec_.choices.end()));
+  }
+  void validate(const Teuchos::ParameterEntry& entry, const std::string& name,
+                const std::string& sublist) const override {
+    const std::string reason = spec_.check(value_of(entry, name, sublist));
+    if (!reason.empty())
+      throw Teuchos::Exceptions::InvalidParameterValue(sublist + "/" + name + ": " + reason);
+  }
+  // The typed value of an entry; ints are accepted where doubles are declared.
+  ParameterValue value_of(const Teuchos::ParameterEntry& entry, const std::string& name,
+                          const std::string& sublist) const {
+    const auto& any = entry.getAny(false);
+    switch (spec_.type) {
+      case ParameterSpec::Type::real:
+        if (any.type() == typeid(double)) return Teuchos::any_cast<double>(any);
+        if (any.type() == typeid(int)) return static_cast<double>(Teuchos::any_cast<int>(any));
+        break;
+      case ParameterSpec::Type::integer:
+        if (any.type() == typeid(int)) return Teuchos::any_cast<int>(any);
+        break;
+      case ParameterSpec::Type::boolean:
+        if (any.type() == typeid(bool)) return Teuchos::any_cast<bool>(any);
+        break;
+      case ParameterSpec::Type::string:
+        if (any.type() == typeid(std::string)) return Teuchos::any_cast<std::string>(any);
+        break;
+      case ParameterSpec::Type::vector3:
+        if (any.type() == typeid(Teuchos::Array<double>)) {
+          const auto& a = Teuchos::any_cast<Teuchos::Array<double>>(any);
+          if (a.size() == 3) return Vec3(a[0], a[1], a[2]);
+          throw Teuchos::Exceptions::InvalidParameterType(
+              sublist + "/" + name + ": expected 3 numbers, got " + std::to_string(a.size()));
+        }
+        break;
+    }
+    throw Teuchos::Exceptions::InvalidParameterType(sublist + "/" + name + ": expected type " +
+                                                    ParameterSpec::type_name(spec_.type) + ", got " +
+                                                    teuchos_type_name(entry));
+  }
+
+ private:
+  ParameterSpec spec_;
+};
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same = std::tolower(a[i - 1]) == std::tolower(b[j - 1]);
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string unknown_reason(const std::string& name, const std::vector<std::string>& candidates,
+                           const char* what) {
+  std::string reason = std::string("unknown ") + what;
+  const std::string hint = closest_name(name, candidates);
+  if (!hint.empty()) reason += " (did you mean '" + hint + "'?)";
+  return reason;
+}
+}  // namespace
+
+std::string closest_name(const std::string& name, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(3, name.size() / 3) + 1;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(name, c);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  return best;
+}
+
+void check_entries(const Teuchos::ParameterList& list, const std::vector<std::string>& allowed_parameters,
+                   const std::vector<std::string>& sublists, const std::string& file, const std::string& path) {
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string& name = list.name(it);
+    const bool is_list = list.entry(it).isList();
+    const auto& allowed = is_list ? sublists : allowed_parameters;
+    if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
+    std::vector<std::string> all = allowed_parameters;
+    all.insert(all.end(), sublists.begin(), sublists.end());
+    fail(file, joined(path, name), unknown_reason(name, all, is_list ? "section" : "parameter"));
+  }
+}
+
+ParameterValues read_parameters(const Teuchos::ParameterList& list, const std::vector<ParameterSpec>& specs,
+                                const std::string& file, const std::string& path,
+                                const std::vector<std::string>& sublists) {
+  std::vector<std::string> names;
+  for (const auto& s : specs) names.push_back(s.name);
+  check_entries(list, names, sublists, file, path);
+  ParameterValues values;
+  for (const auto& spec : specs) {
+    if (!list.isParameter(spec.name)) {
+      values.set(spec.name, spec.default_value);
+      continue;
+    }
+    const SpecValidator validator(spec);
+    const auto& entry = list.getEntry(spec.name);
+    try {
+      if (entry.isList()) throw Teuchos::Exceptions::InvalidParameterType("/: expected a parameter, got a section");
+      validator.validate(entry, spec.name, path);
+      values.set(spec.name, validator.value_of(entry, spec.name, path));
+    } catch (const std::exception& e) {
+      // Teuchos messages carry "sublist/name: " first; keep the reason only.
+      std::string reason = e.what();
+      const auto colon = reason.find(": ");
+      if (colon != std::string::npos) reason = reason.substr(colon + 2);
+      fail(file, joined(path, spec.name), reason);
+    }
+  }
+  return values;
+}
+
+ParameterValue parse_value(const ParameterSpec& spec, const std::string& text) {
+  std::istringstream in(text);
+  switch (spec.type) {
+    case ParameterSpec::Type::real: {
+      double x;
+      if (in >> x && (in >> std::ws).eof()) return x;
+      break;
+    }
+    case ParameterSpec::Type::integer: {
+      int x;
+      if (in >> x && (in >> std::ws).eof()) return x;
+      break;
+    }
+    case ParameterSpec::Type::boolean:
+      if (text == "true" || text == "1") return true;
+      if (text == "false" || text == "0") return false;
+      break;
+    case ParameterSpec::Type::string: return text;
+    case ParameterSpec::Type::vector3: {
+      std::string cleaned = text;
+      for (char& ch : cleaned)
+        if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
+      std::istringstream v(cleaned);
+      Vec3 x;
+      if (v >> x[0] >> x[1] >> x[2] && (v >> std::ws).eof()) return x;
+      break;
+    }
+  }
+  throw InputError("cannot read '" + text + "' as " + ParameterSpec::type_name(spec.type));
+}
+
+void set_entry(Teuchos::ParameterList& list, const std::string& name, const ParameterValue& value) {
+  std::visit(
+      [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, Vec3>) {
+          list.set(name, Teuchos::Array<double>(Teuchos::tuple(v[0], v[1], v[2])));
+        } else {
+          list.set(name, v);
+        }
+      },
+      value);
+}
+
+Teuchos::RCP<Teuchos::ParameterList> valid_parameter_list(const std::vector<ParameterSpec>& specs) {
+  auto valid = Teuchos::rcp(new Teuchos::ParameterList);
+  for (const auto& spec : specs) {
+    auto validator = Teuchos::rcp(new SpecValidator(spec));
+    std::visit(
+        [&](const auto& v) {
+          using T = std::decay_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, Vec3>) {
+            valid->set(spec.name, Teuchos::Array<double>(Teuchos::tuple(v[0], v[1], v[2])), spec.doc, validator);
+          } else {
+            valid->set(spec.name, v, spec.doc, validator);
+          }
+        },
+        spec.default_value);
+  }
+  return valid;
+}
+
+Teuchos::RCP<Teuchos::ParameterList> read_xml_file(const std::string& file) {
+  if (!std::ifstream(file).good()) throw InputError(file + ": cannot open file");
+  try {
+    return Teuchos::getParametersFromXmlFile(file);
+  } catch (const std::exception& e) {
+    std::string reason = e.what();
+    std::replace(reason.begin(), reason.end(), '\n', ' ');
+    throw InputError(file + ": not a valid XML parameter list (" + reason.substr(0, 200) + ")");
+  }
+}
+
+}  // namespace viscompm::scene

@@ -1,0 +1,314 @@
+#include "viscompm/scene/scene.hpp"
+
+#include <Teuchos_ParameterList.hpp>
+#include <filesystem>
+#include <sstream>
+
+#include "viscompm/core/error.hpp"
+#include "viscompm/core/shape.hpp"
+#include "viscompm/materials/registry.hpp"
+#include "viscompm/scene/parameter_io.hpp"
+
+namespace viscompm::scene {
+
+const ParameterTable<SimulationSettings>& SimulationSettings::table() {
+  static const ParameterTable<SimulationSettings> t = [] {
+    ParameterTable<SimulationSettings> table;
+    using S = SimulationSettings;
+    table.integer(&S::frames, "Frames", 24, Range::at_least(0), "frames to simulate after frame 0")
+        .real(&S::frame_rate, "Frame rate", 24.0, Range::positive(), "frames per second of simulated time")
+        .real(&S::cfl, "CFL", 0.5, Range::open_closed(0.0, 10.0), "Δt ≤ CFL·Δx / max particle speed")
+        .real(&S::max_time_step, "Max time step", 1e-2, Range::positive(), "upper bound of Δt [s]")
+        .real(&S::min_time_step, "Min time step", 1e-7, Range::positive(),
+              "smallest Δt tried when Newton fails before the run stops [s]")
+        .vector3(&S::gravity, "Gravity", Vec3(0.0, -9.81, 0.0), "gravitational acceleration [m/s^2]")
+        .string(&S::transfer, "Transfer", "apic", {"apic", "pic_flip"}, "particle-grid transfer (§3.4, §5.6)")
+        .real(&S::flip_ratio, "FLIP ratio", 0.95, Range::closed(0.0, 1.0), "α of the PIC/FLIP blend (pic_flip only)")
+        .string(&S::kernel, "Kernel", "quadratic", {"quadratic", "cubic"}, "B-spline interpolation (§3.1)");
+    return table;
+  }();
+  return t;
+}
+
+const ParameterTable<GridSettings>& GridSettings::table() {
+  static const ParameterTable<GridSettings> t = [] {
+    ParameterTable<GridSettings> table;
+    using G = GridSettings;
+    table.vector3(&G::lower_corner, "Lower corner", Vec3::Zero(), "lower corner of the domain [m]")
+        .vector3(&G::upper_corner, "Upper corner", Vec3::Ones(), "upper corner of the domain [m]")
+        .real(&G::cell_size, "Cell size", 0.05, Range::positive(), "grid spacing Δx [m]")
+        .string(&G::walls, "Walls", "separating", {"sticky", "slip", "separating"}, "contact at the domain faces")
+        .integer(&G::wall_thickness, "Wall thickness", 2, Range::closed(1, 8),
+                 "nodes closer than this many cells to a face are wall nodes");
+    return table;
+  }();
+  return t;
+}
+
+namespace {
+template <class S>
+void add_shape_parameters(ParameterTable<S>& table) {
+  table.string(&S::shape, "Shape", "box", {"box", "sphere", "cylinder", "half_space"}, "solid shape")
+      .vector3(&S::lower_corner, "Lower corner", Vec3::Zero(), "box: lower corner [m]")
+      .vector3(&S::upper_corner, "Upper corner", Vec3::Ones(), "box: upper corner [m]")
+      .vector3(&S::center, "Center", Vec3::Zero(), "sphere, cylinder: centre; half_space: a point on its plane [m]")
+      .real(&S::radius, "Radius", 0.1, Range::positive(), "sphere, cylinder: radius [m]")
+      .vector3(&S::axis, "Axis", Vec3::UnitY(), "cylinder: axis direction")
+      .real(&S::length, "Length", 1.0, Range::positive(), "cylinder: length along its axis [m]")
+      .vector3(&S::normal, "Normal", Vec3::UnitY(), "half_space: outward normal (the solid is below the plane)");
+}
+
+Shape make_shape(const ShapeSettings& s, const std::string& file, const std::string& path) {
+  Shape shape;
+  shape.kind = Shape::kind_from_name(s.shape);
+  shape.lower = s.lower_corner;
+  shape.upper = s.upper_corner;
+  shape.center = s.center;
+  shape.radius = s.radius;
+  shape.length = s.length;
+  const Vec3 direction = shape.kind == Shape::Kind::half_space ? s.normal : s.axis;
+  if (direction.norm() == 0.0) throw InputError(file + ": parameter '" + path + "': direction must be non-zero");
+  shape.axis = direction.normalized();
+  if (shape.kind == Shape::Kind::box && !(s.upper_corner.array() > s.lower_corner.array()).all())
+    throw InputError(file + ": parameter '" + path + "/Upper corner': must exceed Lower corner in every component");
+  return shape;
+}
+
+constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver", "Output", "Materials", "Bodies", "Colliders"};
+
+const std::vector<ParameterSpec>* fixed_section_specs(const std::string& section) {
+  if (section == "Simulation") return &SimulationSettings::table().specs();
+  if (section == "Grid") return &GridSettings::table().specs();
+  if (section == "Newton") return &implicit::NewtonSettings::table().specs();
+  if (section == "Solver") return &SolverFileSettings::table().specs();
+  if (section == "Output") return &OutputSettings::table().specs();
+  if (section == "Bodies") return &BodySettings::table().specs();
+  if (section == "Colliders") return &ColliderSettings::table().specs();
+  return nullptr;
+}
+
+ParameterSpec model_spec() {
+  ParameterSpec spec;
+  spec.name = "Model";
+  spec.type = ParameterSpec::Type::string;
+  spec.default_value = std::string();
+  spec.choices = materials::model_names();
+  spec.doc = "constitutive model";
+  return spec;
+}
+
+std::vector<std::string> split_path(const std::string& path) {
+  std::vector<std::string> parts;
+  std::stringstream in(path);
+  for (std::string part; std::getline(in, part, '/');)
+    if (!part.empty()) parts.push_back(part);
+  return parts;
+}
+
+// The declaration of the parameter at `parts` (section[/item]/name) of `list`, or nullptr.
+const ParameterSpec* find_spec(const Teuchos::ParameterList& list, const std::vector<std::string>& parts,
+                               std::vector<ParameterSpec>& storage) {
+  if (parts.size() < 2) return nullptr;
+  const std::string& section = parts[0];
+  const std::string& name = parts.back();
+  const std::vector<ParameterSpec>* specs = nullptr;
+  if (section == "Materials") {
+    if (parts.size() != 3) return nullptr;
+    storage = {model_spec()};
+    const std::string* model = nullptr;
+    if (list.isSublist("Materials") && list.sublist("Materials").isSublist(parts[1]))
+      model = list.sublist("Materials").sublist(parts[1]).getPtr<std::string>("Model");
+    if (model != nullptr)
+      if (const auto* entry = materials::find_model(*model))
+        storage.insert(storage.end(), entry->parameters.begin(), entry->parameters.end());
+    specs = &storage;
+  } else if (section == "Bodies" || section == "Colliders") {
+    if (parts.size() != 3) return nullptr;
+    specs = fixed_section_specs(section);
+  } else {
+    if (parts.size() != 2) return nullptr;
+    specs = fixed_section_specs(section);
+  }
+  if (specs == nullptr) return nullptr;
+  for (const auto& s : *specs)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+void apply_override(Teuchos::ParameterList& list, const Override& o, const std::string& file) {
+  const auto parts = split_path(o.path);
+  std::vector<ParameterSpec> storage;
+  const ParameterSpec* spec = find_spec(list, parts, storage);
+  if (spec == nullptr) throw InputError(file + ": --set '" + o.path + "': unknown parameter");
+  Teuchos::ParameterList* target = &list;
+  for (std::size_t k = 0; k + 1 < parts.size(); ++k) target = &target->sublist(parts[k]);
+  try {
+    set_entry(*target, parts.back(), parse_value(*spec, o.value));
+  } catch (const InputError& e) {
+    throw InputError(file + ": --set '" + o.path + "': " + e.what());
+  }
+}
+
+template <class Settings>
+Settings read_section(const Teuchos::ParameterList& root, const char* section, const std::string& file) {
+  const Teuchos::ParameterList empty;
+  const Teuchos::ParameterList& list = root.isSublist(section) ? root.sublist(section) : empty;
+  return Settings::table().parse(read_parameters(list, Settings::table().specs(), file, section));
+}
+
+// Each sublist of `section`, read with `read(item_list, path)`.
+template <class F>
+void for_each_item(const Teuchos::ParameterList& root, const char* section, const std::string& file, F&& read) {
+  if (!root.isSublist(section)) return;
+  const Teuchos::ParameterList& list = root.sublist(section);
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string path = std::string(section) + "/" + list.name(it);
+    if (!list.entry(it).isList())
+      throw InputError(file + ": parameter '" + path + "': expected a sublist (one per item)");
+    read(list.name(it), Teuchos::getValue<Teuchos::ParameterList>(list.entry(it)), path);
+  }
+}
+}  // namespace
+
+const ParameterTable<BodySettings>& BodySettings::table() {
+  static const ParameterTable<BodySettings> t = [] {
+    ParameterTable<BodySettings> table;
+    using B = BodySettings;
+    add_shape_parameters(table);
+    table.string(&B::material, "Material", "", {}, "name of a sublist of Materials")
+        .integer(&B::particles_per_cell, "Particles per cell", 2, Range::closed(1, 8),
+                 "particles per cell and dimension")
+        .vector3(&B::velocity, "Velocity", Vec3::Zero(), "initial velocity [m/s]")
+        .vector3(&B::angular_velocity, "Angular velocity", Vec3::Zero(),
+                 "initial angular velocity about the shape's centre [rad/s]");
+    return table;
+  }();
+  return t;
+}
+
+const ParameterTable<ColliderSettings>& ColliderSettings::table() {
+  static const ParameterTable<ColliderSettings> t = [] {
+    ParameterTable<ColliderSettings> table;
+    using C = ColliderSettings;
+    add_shape_parameters(table);
+    table.string(&C::contact, "Contact", "sticky", {"sticky", "slip", "separating"},
+                 "sticky: nodes inside move with the solid (Dirichlet grips); slip: normal only; separating: slip while approaching")
+        .vector3(&C::velocity, "Velocity", Vec3::Zero(), "kinematic velocity [m/s]")
+        .real(&C::start_time, "Start time", 0.0, Range::non_negative(), "time the solid starts moving [s]")
+        .real(&C::stop_time, "Stop time", 1e30, Range::non_negative(), "time the solid stops moving [s]");
+    return table;
+  }();
+  return t;
+}
+
+const ParameterTable<SolverFileSettings>& SolverFileSettings::table() {
+  static const ParameterTable<SolverFileSettings> t = [] {
+    ParameterTable<SolverFileSettings> table;
+    table.string(&SolverFileSettings::file, "File", "../solvers/jacobi_cg.xml", {},
+                 "solver XML, relative to the scene file (--solver overrides it)");
+    return table;
+  }();
+  return t;
+}
+
+const ParameterTable<OutputSettings>& OutputSettings::table() {
+  static const ParameterTable<OutputSettings> t = [] {
+    ParameterTable<OutputSettings> table;
+    table.string(&OutputSettings::directory, "Directory", "output", {},
+                 "where frames, particles.xdmf and solver.csv go (--output overrides it)");
+    return table;
+  }();
+  return t;
+}
+
+Override Override::parse(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set '" + text + "': expected Path/To/Parameter=value");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides) {
+  auto root = read_xml_file(file);
+  for (const auto& o : overrides) apply_override(*root, o, file);
+
+  SceneConfig scene;
+  scene.file = file;
+  scene.name = std::filesystem::path(file).stem().string();
+  check_entries(*root, {}, std::vector<std::string>(std::begin(section_names), std::end(section_names)), file, "");
+  scene.simulation = read_section<SimulationSettings>(*root, "Simulation", file);
+  scene.grid = read_section<GridSettings>(*root, "Grid", file);
+  scene.newton = read_section<implicit::NewtonSettings>(*root, "Newton", file);
+  scene.output = read_section<OutputSettings>(*root, "Output", file);
+  const auto solver = read_section<SolverFileSettings>(*root, "Solver", file);
+  const std::filesystem::path solver_path(solver.file);
+  scene.solver_file = solver_path.is_absolute()
+                          ? solver_path.string()
+                          : (std::filesystem::path(file).parent_path() / solver_path).lexically_normal().string();
+
+  for_each_item(*root, "Materials", file, [&](const std::string& name, const Teuchos::ParameterList& list,
+                                              const std::string& path) {
+    if (!list.isParameter("Model"))
+      throw InputError(file + ": parameter '" + path + "/Model': missing (one of the registered models)");
+    const ParameterValues model_value = read_parameters(
+        Teuchos::ParameterList().set("Model", list.get<std::string>("Model")), {model_spec()}, file, path);
+    const auto* entry = materials::find_model(model_value.string("Model"));
+    std::vector<ParameterSpec> specs = {model_spec()};
+    specs.insert(specs.end(), entry->parameters.begin(), entry->parameters.end());
+    scene.materials.push_back({name, entry->model, read_parameters(list, specs, file, path)});
+  });
+  for_each_item(*root, "Bodies", file, [&](const std::string& name, const Teuchos::ParameterList& list,
+                                           const std::string& path) {
+    BodySettings body = BodySettings::table().parse(read_parameters(list, BodySettings::table().specs(), file, path));
+    body.name = name;
+    bool known = false;
+    for (const auto& m : scene.materials) known |= m.name == body.material;
+    if (!known) throw InputError(file + ": parameter '" + path + "/Material': no material named '" + body.material + "'");
+    if (body.shape == "half_space") throw InputError(file + ": parameter '" + path + "/Shape': a body must be bounded");
+    make_shape(body, file, path);
+    scene.bodies.push_back(body);
+  });
+  for_each_item(*root, "Colliders", file, [&](const std::string& name, const Teuchos::ParameterList& list,
+                                              const std::string& path) {
+    ColliderSettings collider =
+        ColliderSettings::table().parse(read_parameters(list, ColliderSettings::table().specs(), file, path));
+    collider.name = name;
+    make_shape(collider, file, path);
+    scene.colliders.push_back(collider);
+  });
+
+  // Cross-parameter checks.
+  if (scene.bodies.empty()) throw InputError(file + ": parameter 'Bodies': the scene has no bodies");
+  if (!(scene.grid.upper_corner.array() > scene.grid.lower_corner.array()).all())
+    throw InputError(file + ": parameter 'Grid/Upper corner': must exceed Lower corner in every component");
+  const Vec3 extent = scene.grid.upper_corner - scene.grid.lower_corner;
+  if (extent.minCoeff() < 2.0 * (scene.grid.wall_thickness + 2) * scene.grid.cell_size)
+    throw InputError(file + ": parameter 'Grid/Cell size': the domain must be several cells wide in every direction");
+  if (scene.simulation.min_time_step > scene.simulation.max_time_step)
+    throw InputError(file + ": parameter 'Simulation/Min time step': exceeds Max time step");
+  return scene;
+}
+
+Shape shape_of(const ShapeSettings& s) { return make_shape(s, "", ""); }
+
+std::string describe_scene_parameters() {
+  std::ostringstream out;
+  auto section = [&](const std::string& title, const std::vector<ParameterSpec>& specs) {
+    out << "  " << title << "\n";
+    for (const auto& s : specs)
+      out << "    " << s.name << " (" << ParameterSpec::type_name(s.type) << ", " << s.range_text() << "): " << s.doc
+          << "\n";
+  };
+  section("Simulation", SimulationSettings::table().specs());
+  section("Grid", GridSettings::table().specs());
+  section("Newton", implicit::NewtonSettings::table().specs());
+  section("Solver", SolverFileSettings::table().specs());
+  section("Output", OutputSettings::table().specs());
+  section("Bodies/<name>", BodySettings::table().specs());
+  section("Colliders/<name>", ColliderSettings::table().specs());
+  for (const auto& m : materials::model_registry())
+    section("Materials/<name> with Model = " + m.model + " (" + m.summary + ")", m.parameters);
+  return out.str();
+}
+
+}  // namespace viscompm::scene

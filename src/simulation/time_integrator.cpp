@@ -1,0 +1,110 @@
+#include "viscompm/simulation/time_integrator.hpp"
+
+#include <Teuchos_TimeMonitor.hpp>
+
+#include "viscompm/parallel/migration.hpp"
+
+namespace viscompm::simulation {
+
+namespace {
+Teuchos::RCP<Teuchos::Time> timer(const char* name) { return Teuchos::TimeMonitor::getNewCounter(name); }
+}  // namespace
+
+TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::GridGeometry& geometry,
+                               grid::KernelOrder order, const parallel::BlockDecomposition& decomposition,
+                               const IntegratorSettings& settings, const materials::MaterialList& materials,
+                               const boundary::Boundary& boundary, const linalg::SolverConfiguration& solver)
+    : comm_(comm),
+      decomposition_(decomposition),
+      settings_(settings),
+      materials_(materials),
+      boundary_(boundary),
+      space_(comm),
+      system_(space_, solver) {
+  layout_.geometry = geometry;
+  layout_.order = order;
+}
+
+StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, double dt) {
+  static const auto layout_timer = timer("viscompm: 1 layout");
+  static const auto p2g_timer = timer("viscompm: 2 p2g");
+  static const auto newton_timer = timer("viscompm: 3 newton");
+  static const auto g2p_timer = timer("viscompm: 4 g2p");
+  static const auto advect_timer = timer("viscompm: 5 advect");
+  StepReport report;
+  report.dt = dt;
+  {
+    Teuchos::TimeMonitor m(*layout_timer);
+    build_layout(particles);
+  }
+  {
+    Teuchos::TimeMonitor m(*p2g_timer);
+    particles_to_grid(particles);
+  }
+  const std::unique_ptr<StepObjective> objective = build_objective(particles, t, dt);
+  NodeVectorField v = objective->initial_guess;
+  {
+    Teuchos::TimeMonitor m(*newton_timer);
+    const int builds = system_.graph_builds();
+    report.newton = implicit::newton_solve(*objective->potential, space_, system_, settings_.newton, v);
+    report.graph_rebuilt = system_.graph_builds() != builds;
+  }
+  if (!report.newton.converged) return report;
+  {
+    Teuchos::TimeMonitor m(*g2p_timer);
+    grid_to_particles(particles, v, dt);
+  }
+  {
+    Teuchos::TimeMonitor m(*advect_timer);
+    advect(particles, dt, report);
+  }
+  return report;
+}
+
+std::unique_ptr<StepObjective> TimeIntegrator::build_objective(const particles::ParticleSet& particles, double t,
+                                                               double dt) const {
+  // Inertia toward v* = v^n + Δt g; colliders fix the constrained components; the initial
+  // guess is v* with the constraints applied.
+  auto objective = std::make_unique<StepObjective>();
+  objective->v_star.resize(v_old_.size());
+  for (std::size_t i = 0; i < v_old_.size(); ++i) objective->v_star[i] = v_old_[i] + dt * settings_.gravity;
+  objective->constraints = boundary_.constrain(layout_, t, objective->v_star);
+  objective->initial_guess = objective->v_star;
+  objective->constraints.apply(objective->initial_guess);
+  objective->potential = std::make_unique<implicit::IncrementalPotential>(
+      particles, layout_, materials_, mass_, objective->v_star, objective->constraints, dt);
+  // Newton needs a feasible start (E < ∞). Where v* is not, the velocities of time n often are.
+  if (comm_.any(!objective->potential->energy(objective->initial_guess).feasible())) {
+    NodeVectorField previous = v_old_;
+    objective->constraints.apply(previous);
+    if (!comm_.any(!objective->potential->energy(previous).feasible())) objective->initial_guess = previous;
+  }
+  return objective;
+}
+
+void TimeIntegrator::build_layout(particles::ParticleSet& particles) {
+  const std::vector<NodeId> touched = grid::bin_particles(particles, layout_);
+  space_.update(touched, decomposition_, layout_);
+}
+
+void TimeIntegrator::particles_to_grid(const particles::ParticleSet& particles) {
+  transfer::particles_to_grid(particles, layout_, settings_.transfer.scheme, mass_, momentum_);
+  space_.accumulate(mass_);
+  space_.accumulate(momentum_);
+  v_old_ = transfer::grid_velocity(mass_, momentum_);
+}
+
+void TimeIntegrator::grid_to_particles(particles::ParticleSet& particles, const NodeVectorField& v, double dt) {
+  const std::vector<Mat3> A = transfer::grid_to_particles(particles, layout_, settings_.transfer, v, v_old_, dt);
+  const materials::StepContext step{dt};
+  for (std::size_t p = 0; p < particles.size(); ++p)
+    materials_[particles.material_id[p]]->update_state(particles, p, A[p], step);
+}
+
+void TimeIntegrator::advect(particles::ParticleSet& particles, double dt, StepReport& report) {
+  for (std::size_t p = 0; p < particles.size(); ++p) particles.position[p] += dt * particles.velocity[p];
+  report.particles_clamped = boundary_.clamp_particles(layout_.geometry, particles.position);
+  parallel::migrate_particles(comm_, decomposition_, layout_.geometry, layout_.order, particles);
+}
+
+}  // namespace viscompm::simulation

@@ -1,0 +1,148 @@
+#!/usr/bin/env python3
+"""The viscompm program end to end, as users and scripts see it (DESIGN.md section 4):
+--help, exit codes with one-line messages, and the output read back with h5py: the HDF5 frame
+schema, the XDMF index ParaView opens, and solver.csv."""
+import argparse
+import csv
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--viscompm", required=True)
+parser.add_argument("--ranks", type=int, default=1)
+parser.add_argument("--mpiexec", required=True)
+parser.add_argument("--inputs", required=True)
+parser.add_argument("--workdir", required=True)
+args = parser.parse_args()
+
+scene = os.path.join(args.inputs, "scenes", "shooting_sponge.xml")
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+        print("FAIL:", message)
+
+
+def run(*extra):
+    command = shlex.split(args.mpiexec) + ["-np", str(args.ranks), args.viscompm, *extra]
+    return subprocess.run(command, capture_output=True, text=True, timeout=600)
+
+
+def stderr_lines(result):
+    # mpiexec may add its own lines when a rank exits non-zero; ours start with "viscompm:".
+    return [line for line in result.stderr.splitlines() if line.startswith("viscompm")]
+
+
+shutil.rmtree(args.workdir, ignore_errors=True)
+os.makedirs(args.workdir)
+
+# --help: exit 0, documents the options and the scene parameters.
+result = run("--help")
+check(result.returncode == 0, f"--help exits 0, got {result.returncode}")
+for word in ("--output", "--set", "--solver", "--frames", "Weissenberg number"):
+    check(word in result.stdout, f"--help mentions {word}")
+check(result.stdout.count("Usage: viscompm") == 1, "--help is printed once (rank 0)")
+
+# Bad input: exit 2 and one line naming the file and the parameter.
+result = run("/nonexistent/scene.xml")
+check(result.returncode == 2, f"missing scene exits 2, got {result.returncode}")
+lines = stderr_lines(result)
+check(len(lines) == 1 and "/nonexistent/scene.xml" in lines[0], f"one line naming the file: {lines}")
+result = run(scene, "--set", "Materials/sponge/Weissenberg number=-3", "--output", os.path.join(args.workdir, "bad"))
+check(result.returncode == 2, f"out-of-range --set exits 2, got {result.returncode}")
+lines = stderr_lines(result)
+check(len(lines) == 1 and scene in lines[0] and "'Materials/sponge/Weissenberg number'" in lines[0],
+      f"one line naming file and parameter: {lines}")
+result = run(scene, "--frames", "1", "--solver", os.path.join(args.inputs, "scenes", "shooting_sponge.xml"))
+check(result.returncode == 2, f"a scene given as solver file exits 2, got {result.returncode}")
+
+# A small run of the default scene.
+out = os.path.join(args.workdir, "run")
+small = ["--set", "Grid/Cell size=0.06", "--set", "Simulation/Frame rate=120"]
+result = run(scene, "--output", out, "--frames", "2", *small)
+check(result.returncode == 0, f"run exits 0, got {result.returncode}: {result.stderr[-2000:]}")
+check(result.stdout.count("frame    2/2") == 1, "a progress line per frame, printed once")
+files = sorted(os.listdir(out)) if os.path.isdir(out) else []
+check(files == ["frame_00000.h5", "frame_00001.h5", "frame_00002.h5", "particles.xdmf", "solver.csv"],
+      f"output files: {files}")
+
+ids0 = None
+for frame in range(3):
+    path = os.path.join(out, f"frame_{frame:05d}.h5")
+    if not os.path.exists(path):
+        continue
+    with h5py.File(path, "r") as f:
+        check(f.attrs["frame"] == frame, "frame attribute")
+        check(abs(f.attrs["time"] - frame / 120.0) < 1e-12, f"time attribute {f.attrs['time']}")
+        check(f.attrs["step"] >= frame, "step attribute")
+        p = f["particles"]
+        n = p["id"].shape[0]
+        expected = {"id": ((n,), np.int64), "position": ((n, 3), np.float64), "velocity": ((n, 3), np.float64),
+                    "mass": ((n,), np.float64), "volume0": ((n,), np.float64), "material_id": ((n,), np.int32),
+                    "deformation_gradient": ((n, 3, 3), np.float64),
+                    "left_cauchy_green_ob": ((n, 3, 3), np.float64),
+                    "left_cauchy_green_elastic": ((n, 3, 3), np.float64)}
+        for name, (shape, dtype) in expected.items():
+            check(name in p and p[name].shape == shape and p[name].dtype == dtype,
+                  f"frame {frame}: dataset {name} {shape} {dtype}")
+        ids = np.sort(p["id"][...])
+        check(len(np.unique(ids)) == n, "ids are unique")
+        if ids0 is None:
+            ids0 = ids
+        check(np.array_equal(ids, ids0), "ids are stable across frames")
+        F = p["deformation_gradient"][...]
+        bE = p["left_cauchy_green_elastic"][...]
+        J = np.linalg.det(F)
+        check(np.allclose(np.linalg.det(bE), J * J, rtol=1e-9), "det b^E = J^2 (5.5)")
+        check(np.all(p["mass"][...] > 0), "masses are positive")
+
+# The XDMF index: every frame, with datasets that exist and dimensions that match.
+xdmf = os.path.join(out, "particles.xdmf")
+if os.path.exists(xdmf):
+    grids = ET.parse(xdmf).getroot().findall("./Domain/Grid/Grid")
+    check(len(grids) == 3, f"xdmf lists 3 frames, got {len(grids)}")
+    for grid in grids:
+        for item in grid.iter("DataItem"):
+            file_name, dataset = item.text.split(":")
+            with h5py.File(os.path.join(out, file_name), "r") as f:
+                dims = tuple(int(d) for d in item.attrib["Dimensions"].split())
+                check(dataset in f and f[dataset].shape == dims, f"xdmf item {item.text} {dims}")
+
+# solver.csv: the contract's columns, one row per linear solve.
+csv_path = os.path.join(out, "solver.csv")
+if os.path.exists(csv_path):
+    with open(csv_path) as f:
+        reader = csv.reader(f)
+        header = next(reader)
+        rows = list(reader)
+    check(header == ["step", "newton_iteration", "linear_iterations", "relative_residual", "setup_seconds",
+                     "solve_seconds", "preconditioner", "ranks"], f"solver.csv header {header}")
+    check(len(rows) > 0, "solver.csv has rows")
+    check(all(int(r[7]) == args.ranks for r in rows), "ranks column")
+    check(all(float(r[3]) < 1e-5 for r in rows), "relative residuals meet the solver tolerance")
+    newton_total = int(result.stdout.split("Newton iterations")[0].split(",")[-1]) if "Newton iterations" in result.stdout else -1
+    check(len(rows) == newton_total, f"one row per Newton iteration: {len(rows)} vs {newton_total}")
+
+# A run that fails keeps the frames written so far: exit 3.
+failed_out = os.path.join(args.workdir, "failed")
+result = run(scene, "--output", failed_out, "--frames", "2", *small, "--set", "Newton/Max iterations=1",
+             "--set", "Newton/Tolerance=1e-14", "--set", "Simulation/Min time step=0.004")
+check(result.returncode == 3, f"failed simulation exits 3, got {result.returncode}")
+check(len(stderr_lines(result)) == 1, f"one line on stderr: {stderr_lines(result)}")
+frame0 = os.path.join(failed_out, "frame_00000.h5")
+check(os.path.exists(frame0), "frame 0 of the failed run is intact")
+if os.path.exists(frame0):
+    with h5py.File(frame0, "r") as f:
+        check(f["particles/position"].shape[0] > 0, "frame 0 is readable")
+
+print(f"{len(failures)} failure(s)")
+sys.exit(1 if failures else 0)

@@ -1,0 +1,167 @@
+// Scene and solver files are validated on read: an unknown or misspelled parameter, a wrong type
+// or an out-of-range value is one line naming the file and the parameter path.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "viscompm/core/error.hpp"
+#include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/scene/command_line.hpp"
+#include "viscompm/scene/scene.hpp"
+
+using namespace viscompm;
+
+namespace {
+const std::string inputs = VISCOMPM_SOURCE_DIR "/inputs";
+const std::string default_scene = inputs + "/scenes/shooting_sponge.xml";
+
+std::string read_text(const std::string& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The default scene with `from` replaced by `to`, written next to the original (so the relative
+// solver path still resolves).
+std::string variant(const std::string& from, const std::string& to) {
+  std::string text = read_text(default_scene);
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  const std::string file = std::filesystem::temp_directory_path() / ("viscompm_scene_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(file) << text;
+  return file;
+}
+
+// The message of the InputError that reading `file` raises.
+std::string read_error(const std::string& file, const std::vector<scene::Override>& overrides = {}) {
+  try {
+    scene::read_scene(file, overrides);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expect_one_line_naming(const std::string& message, const std::string& file, const std::string& parameter) {
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_EQ(message.rfind(file, 0), 0u) << message;
+  EXPECT_NE(message.find("'" + parameter + "'"), std::string::npos) << message;
+}
+}  // namespace
+
+TEST(Scene, ReadsTheDefaultScene) {
+  const auto s = scene::read_scene(default_scene);
+  EXPECT_EQ(s.name, "shooting_sponge");
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[0].model, "oldroyd_b");
+  EXPECT_EQ(s.materials[0].values.real("Shear modulus"), 360.0);
+  EXPECT_EQ(s.materials[0].values.real("Lame lambda"), 1400.0);
+  EXPECT_EQ(s.materials[0].values.real("Weissenberg number"), 50.0);
+  EXPECT_EQ(s.bodies.size(), 1u);
+  EXPECT_EQ(s.colliders.size(), 3u);
+  EXPECT_EQ(s.grid.cell_size, 0.03);
+  EXPECT_TRUE(std::filesystem::exists(s.solver_file)) << s.solver_file;
+  // Missing parameters take their declared defaults.
+  EXPECT_EQ(s.newton.armijo, 1e-4);
+}
+
+TEST(Scene, UnknownParameterNamesTheFileThePathAndTheNearestName) {
+  const std::string file = variant("name=\"Shear modulus\"", "name=\"Shear modulos\"");
+  const std::string message = read_error(file);
+  expect_one_line_naming(message, file, "Materials/sponge/Shear modulos");
+  EXPECT_NE(message.find("did you mean 'Shear modulus'"), std::string::npos) << message;
+}
+
+TEST(Scene, WrongTypeIsRejected) {
+  const std::string file = variant("name=\"Frames\" type=\"int\" value=\"18\"", "name=\"Frames\" type=\"string\" value=\"many\"");
+  const std::string message = read_error(file);
+  expect_one_line_naming(message, file, "Simulation/Frames");
+  EXPECT_NE(message.find("expected type int"), std::string::npos) << message;
+}
+
+TEST(Scene, OutOfRangeValueIsRejected) {
+  const std::string file = variant("name=\"Weissenberg number\" type=\"double\" value=\"50\"",
+                                   "name=\"Weissenberg number\" type=\"double\" value=\"-1\"");
+  const std::string message = read_error(file);
+  expect_one_line_naming(message, file, "Materials/sponge/Weissenberg number");
+  EXPECT_NE(message.find("out of range (0, inf]"), std::string::npos) << message;
+}
+
+TEST(Scene, UnknownSectionAndUnknownModelAreRejected) {
+  std::string file = variant("<ParameterList name=\"Grid\">", "<ParameterList name=\"Gird\">");
+  expect_one_line_naming(read_error(file), file, "Gird");
+  file = variant("value=\"oldroyd_b\"", "value=\"oldroid_b\"");
+  expect_one_line_naming(read_error(file), file, "Materials/sponge/Model");
+  file = variant("name=\"Material\" type=\"string\" value=\"sponge\"", "name=\"Material\" type=\"string\" value=\"foam\"");
+  expect_one_line_naming(read_error(file), file, "Bodies/sponge/Material");
+}
+
+TEST(Scene, MissingFileAndMalformedXmlAreInputErrors) {
+  EXPECT_NE(read_error("/nonexistent/scene.xml").find("cannot open"), std::string::npos);
+  const std::string file = variant("</ParameterList>\n</ParameterList>", "</ParameterList>");
+  EXPECT_NE(read_error(file).find("not a valid XML"), std::string::npos);
+}
+
+TEST(Scene, SetOverridesOneParameterByPath) {
+  const auto s = scene::read_scene(default_scene, {{"Materials/sponge/Weissenberg number", "7"},
+                                                   {"Simulation/Gravity", "{0, 0, -1}"},
+                                                   {"Newton/Hessian projection", "always"},
+                                                   {"Colliders/bullet/Radius", "0.1"}});
+  EXPECT_EQ(s.materials[0].values.real("Weissenberg number"), 7.0);
+  EXPECT_EQ(s.simulation.gravity, Vec3(0, 0, -1));
+  EXPECT_EQ(s.newton.hessian_projection, "always");
+  EXPECT_EQ(s.colliders[2].radius, 0.1);
+}
+
+TEST(Scene, BadOverridesAreInputErrors) {
+  expect_one_line_naming(read_error(default_scene, {{"Simulation/Framez", "3"}}), default_scene, "Simulation/Framez");
+  EXPECT_NE(read_error(default_scene, {{"Simulation/Frames", "three"}}).find("cannot read 'three' as int"),
+            std::string::npos);
+  // Values set by --set are validated like values in the file.
+  expect_one_line_naming(read_error(default_scene, {{"Grid/Cell size", "-0.1"}}), default_scene, "Grid/Cell size");
+}
+
+TEST(CommandLine, AcceptsTheContractForms) {
+  const char* argv[] = {"viscompm", "scene.xml", "--output", "out", "--frames=3", "--set", "A/B=1",
+                        "--set=C/D=2", "--solver", "s.xml"};
+  const auto cl = scene::parse_command_line(10, argv, scene::ProgramOptions{"viscompm", "test"});
+  EXPECT_EQ(cl.input_file, "scene.xml");
+  EXPECT_EQ(cl.solver_file, "s.xml");
+  ASSERT_EQ(cl.overrides.size(), 4u);
+  EXPECT_EQ(cl.overrides[0].path, "A/B");
+  EXPECT_EQ(cl.overrides[1].value, "2");
+  EXPECT_EQ(cl.overrides[2].path, "Output/Directory");
+  EXPECT_EQ(cl.overrides[3].path, "Simulation/Frames");
+  const char* bad[] = {"viscompm", "scene.xml", "--bogus=1"};
+  EXPECT_THROW(scene::parse_command_line(3, bad, scene::ProgramOptions{"viscompm", "test"}), InputError);
+  const char* none[] = {"viscompm"};
+  EXPECT_THROW(scene::parse_command_line(1, none, scene::ProgramOptions{"viscompm", "test"}), InputError);
+}
+
+TEST(SolverConfiguration, ValidatesBelosAndIfpack2Parameters) {
+  EXPECT_NO_THROW(linalg::SolverConfiguration::read(inputs + "/solvers/jacobi_cg.xml"));
+  auto error = [](const std::string& xml) {
+    try {
+      linalg::SolverConfiguration::from_xml(xml, "solver.xml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string belos = error(
+      "<ParameterList name=\"s\"><ParameterList name=\"Krylov parameters\">"
+      "<Parameter name=\"Convergence Tolerence\" type=\"double\" value=\"1e-6\"/></ParameterList></ParameterList>");
+  expect_one_line_naming(belos, "solver.xml", "Krylov parameters/Convergence Tolerence");
+  EXPECT_NE(belos.find("did you mean 'Convergence Tolerance'"), std::string::npos) << belos;
+  const std::string ifpack2 = error(
+      "<ParameterList name=\"s\"><ParameterList name=\"Preconditioner parameters\">"
+      "<Parameter name=\"relaxation: typo\" type=\"string\" value=\"Jacobi\"/></ParameterList></ParameterList>");
+  expect_one_line_naming(ifpack2, "solver.xml", "Preconditioner parameters/relaxation: typo");
+  expect_one_line_naming(error("<ParameterList name=\"s\"><Parameter name=\"Preconditioner\" type=\"string\" "
+                               "value=\"AMG\"/></ParameterList>"),
+                         "solver.xml", "Preconditioner");
+}

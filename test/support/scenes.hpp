@@ -1,0 +1,89 @@
+// Scenes built in code for the tests (the same structs read_scene fills).
+#pragma once
+
+#include <sstream>
+#include <string>
+
+#include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/materials/oldroyd_b.hpp"
+#include "viscompm/scene/scene.hpp"
+
+namespace viscompm::testkit {
+
+inline scene::SceneConfig base_scene(const Vec3& upper, double dx) {
+  scene::SceneConfig s;
+  s.file = "test";
+  s.name = "test";
+  s.grid.lower_corner = Vec3::Zero();
+  s.grid.upper_corner = upper;
+  s.grid.cell_size = dx;
+  s.grid.walls = "separating";
+  s.simulation.gravity = Vec3::Zero();
+  s.simulation.cfl = 10.0;
+  s.newton.tolerance = 1e-9;
+  s.newton.max_iterations = 30;
+  return s;
+}
+
+inline scene::MaterialSettings oldroyd_b_material(const std::string& name, double density, double mu, double lambda,
+                                                  double viscosity, const std::string& convention, double wi) {
+  scene::MaterialSettings m;
+  m.name = name;
+  m.model = "oldroyd_b";
+  materials::OldroydBParameters p;
+  p.density = density;
+  p.shear_modulus = mu;
+  p.lame_lambda = lambda;
+  p.newtonian_viscosity = viscosity;
+  p.viscosity_convention = convention;
+  p.weissenberg = wi;
+  m.values.set("Density", p.density);
+  m.values.set("Shear modulus", p.shear_modulus);
+  m.values.set("Lame lambda", p.lame_lambda);
+  m.values.set("Newtonian viscosity", p.newtonian_viscosity);
+  m.values.set("Viscosity convention", p.viscosity_convention);
+  m.values.set("Weissenberg number", p.weissenberg);
+  return m;
+}
+
+inline scene::BodySettings box_body(const std::string& material, const Vec3& lo, const Vec3& hi, const Vec3& v) {
+  scene::BodySettings b;
+  b.name = "body";
+  b.shape = "box";
+  b.lower_corner = lo;
+  b.upper_corner = hi;
+  b.material = material;
+  b.velocity = v;
+  return b;
+}
+
+inline scene::ColliderSettings box_collider(const std::string& name, const std::string& contact, const Vec3& lo,
+                                            const Vec3& hi, const Vec3& v = Vec3::Zero()) {
+  scene::ColliderSettings c;
+  c.name = name;
+  c.shape = "box";
+  c.contact = contact;
+  c.lower_corner = lo;
+  c.upper_corner = hi;
+  c.velocity = v;
+  return c;
+}
+
+/// Belos CG with Ifpack2 Jacobi at a given relative tolerance.
+inline linalg::SolverConfiguration jacobi_cg(double tolerance) {
+  std::ostringstream tol;
+  tol << tolerance;
+  return linalg::SolverConfiguration::from_xml(
+      "<ParameterList name=\"test\">"
+      "<Parameter name=\"Preconditioner\" type=\"string\" value=\"Ifpack2\"/>"
+      "<Parameter name=\"Ifpack2 type\" type=\"string\" value=\"RELAXATION\"/>"
+      "<ParameterList name=\"Krylov parameters\">"
+      "<Parameter name=\"Convergence Tolerance\" type=\"double\" value=\"" + tol.str() + "\"/>"
+      "<Parameter name=\"Maximum Iterations\" type=\"int\" value=\"10000\"/></ParameterList>"
+      "<ParameterList name=\"Preconditioner parameters\">"
+      "<Parameter name=\"relaxation: type\" type=\"string\" value=\"Jacobi\"/></ParameterList>"
+      "</ParameterList>",
+      "test solver");
+}
+
+}  // namespace viscompm::testkit
