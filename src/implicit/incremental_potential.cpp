@@ -92,16 +92,25 @@ void IncrementalPotential::element_hessians(
       for (int j = 0; j < K; ++j)
         for (int tau = 0; tau < 3; ++tau)
           HG.col(3 * j + tau) = H.col(tau) * dw[j][0] + H.col(tau + 3) * dw[j][1] + H.col(tau + 6) * dw[j][2];
-      for (int col = 0; col < 3 * K; ++col) {
-        const Vec3 h0 = HG.col(col).segment<3>(0), h1 = HG.col(col).segment<3>(3), h2 = HG.col(col).segment<3>(6);
-        double* e = element.col(col).data();
-        for (int i = 0; i < K; ++i) {
-          const Vec3 block = dw[i][0] * h0 + dw[i][1] * h1 + dw[i][2] * h2;
-          e[3 * i] += block[0];
-          e[3 * i + 1] += block[1];
-          e[3 * i + 2] += block[2];
+      // Upper block triangle only (node i ≤ node j); mirrored once per cell below.
+      for (int j = 0; j < K; ++j)
+        for (int tau = 0; tau < 3; ++tau) {
+          const int col = 3 * j + tau;
+          const Vec3 h0 = HG.col(col).segment<3>(0), h1 = HG.col(col).segment<3>(3), h2 = HG.col(col).segment<3>(6);
+          double* e = element.col(col).data();
+          for (int i = 0; i <= j; ++i) {
+            const Vec3 block = dw[i][0] * h0 + dw[i][1] * h1 + dw[i][2] * h2;
+            e[3 * i] += block[0];
+            e[3 * i + 1] += block[1];
+            e[3 * i + 2] += block[2];
+          }
         }
-      }
+    }
+    // Mirror: the element is exactly symmetric.
+    for (int j = 0; j < K; ++j) {
+      const Mat3 diagonal = element.block<3, 3>(3 * j, 3 * j);
+      element.block<3, 3>(3 * j, 3 * j) = 0.5 * (diagonal + diagonal.transpose());
+      for (int i = 0; i < j; ++i) element.block<3, 3>(3 * j, 3 * i) = element.block<3, 3>(3 * i, 3 * j).transpose();
     }
     // Fixed components: P_i H_ij P_j.
     const int* nodes = layout_.nodes_of_cell(c);

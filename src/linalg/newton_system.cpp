@@ -29,6 +29,9 @@ struct NewtonSystem::Impl {
   Teuchos::RCP<fe_matrix_type> matrix;
   NearNullspace modes;
   std::vector<local_ordinal_type> local_to_column;
+  // For cell c and stencil nodes (a, b): where node b's three columns start in the rows of node
+  // a, relative to the row start (the three rows of a node share one column pattern).
+  std::vector<int> cell_offsets;
 
   void build_graph(const grid::GridLayout& layout);
   void build_near_nullspace(const grid::GridLayout& layout);
@@ -79,6 +82,30 @@ void NewtonSystem::Impl::build_graph(const grid::GridLayout& layout) {
   local_to_column.resize(3 * n);
   for (std::size_t r = 0; r < 3 * n; ++r)
     local_to_column[r] = column_map->getLocalElement(local_dofs.getGlobalElement(static_cast<local_ordinal_type>(r)));
+  const auto local_matrix = matrix->getLocalMatrixHost();
+  const auto& row_map = local_matrix.graph.row_map;
+  const auto& entries = local_matrix.graph.entries;
+  cell_offsets.resize(layout.cell_count() * K * K);
+  for (std::size_t c = 0; c < layout.cell_count(); ++c) {
+    const int* nodes = layout.nodes_of_cell(c);
+    for (int a = 0; a < K; ++a) {
+      for (int d = 0; d < 3; ++d) {
+        const auto row = 3 * nodes[a] + d;
+        const auto* first = entries.data() + row_map(row);
+        const auto* last = entries.data() + row_map(row + 1);
+        for (int b = 0; b < K; ++b) {
+          const local_ordinal_type column = local_to_column[3 * nodes[b]];
+          const auto* at = std::lower_bound(first, last, column);
+          if (at + 2 >= last || at[0] != column || at[1] != column + 1 || at[2] != column + 2)
+            throw std::logic_error("NewtonSystem: a node's three columns are not contiguous in its rows");
+          const int offset = static_cast<int>(at - first);
+          if (d == 0) cell_offsets[(c * K + a) * K + b] = offset;
+          else if (cell_offsets[(c * K + a) * K + b] != offset)
+            throw std::logic_error("NewtonSystem: the rows of a node differ in their columns");
+        }
+      }
+    }
+  }
   matrix->endAssembly();
   graph_cells = layout.cells;
   graph_space_version = space.version();
@@ -119,22 +146,35 @@ void NewtonSystem::assemble(const implicit::IncrementalPotential& potential, con
   const grid::GridLayout& layout = potential.layout();
   const bool rebuild = m.graph.is_null() || m.space.version() != m.graph_space_version ||
                        m.space.comm().any(layout.cells != m.graph_cells);
-  if (rebuild) m.build_graph(layout);
+  if (rebuild) {
+    static const auto graph_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3f newton graph");
+    Teuchos::TimeMonitor timer(*graph_timer);
+    m.build_graph(layout);
+  }
 
   m.matrix->beginAssembly();
   m.matrix->setAllToScalar(0.0);  // beginAssembly keeps old values
   const int K = layout.nodes_per_cell();
-  std::vector<local_ordinal_type> dofs(3 * K), columns(3 * K);
+  // Element blocks go straight into the values of the owned+shared matrix, at offsets found
+  // when the graph was built (no per-entry column search).
+  const auto local_matrix = m.matrix->getLocalMatrixHost();
+  const auto& row_map = local_matrix.graph.row_map;
+  double* values = local_matrix.values.data();
   potential.element_hessians(v, project, [&](std::size_t c, const implicit::ElementMatrix& element) {
     const int* nodes = layout.nodes_of_cell(c);
-    for (int k = 0; k < K; ++k)
+    const int* offsets = m.cell_offsets.data() + c * K * K;
+    for (int a = 0; a < K; ++a)
       for (int d = 0; d < 3; ++d) {
-        dofs[3 * k + d] = 3 * nodes[k] + d;
-        columns[3 * k + d] = m.local_to_column[3 * nodes[k] + d];
+        // Row 3a+d of the symmetric element is its column 3a+d.
+        const double* row_values = element.col(3 * a + d).data();
+        double* row = values + row_map(3 * nodes[a] + d);
+        for (int b = 0; b < K; ++b) {
+          double* target = row + offsets[a * K + b];
+          target[0] += row_values[3 * b];
+          target[1] += row_values[3 * b + 1];
+          target[2] += row_values[3 * b + 2];
+        }
       }
-    // The element is symmetric: column r holds row r contiguously.
-    for (int r = 0; r < 3 * K; ++r)
-      m.matrix->sumIntoLocalValues(dofs[r], 3 * K, element.col(r).data(), columns.data());
   });
   // Inertia: m_i on the diagonal of owned rows.
   for (std::size_t i = 0; i < layout.owned_count; ++i)

@@ -67,22 +67,17 @@ double energy_density(const Coefficients& c, const Mat3& F, const Mat3& S, const
          c.viscous * c.J_n * eps.squaredNorm();
 }
 
-Vec27 energy_gradient(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps) {
+EnergyGradient energy_gradient_blocks(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps) {
   const double J = F.determinant();
-  const double T = S.trace();
   const double e = trace_term(c.mu, J, S);
-  const Vec9 a = inverse_transpose_vec(F.inverse());
-  const Vec9 s = inverse_transpose_vec(S.inverse());
-  const Vec9 iota = vec(Mat3::Identity());
-  Vec27 g;
-  g.segment<9>(0) = (2.0 / 3.0 * e - c.mu + c.lambda * (J - 1.0) * J) * a;
-  g.segment<9>(9) = e * (-s / 3.0 + iota / T);
-  g.segment<9>(18) = 2.0 * c.viscous * c.J_n * vec(eps);
+  EnergyGradient g;
+  g.F = (2.0 / 3.0 * e - c.mu + c.lambda * (J - 1.0) * J) * F.inverse().transpose();
+  g.S = e * (-S.inverse().transpose() / 3.0 + Mat3::Identity() / S.trace());
+  g.eps = 2.0 * c.viscous * c.J_n * eps;
   return g;
 }
 
-Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps) {
-  (void)eps;
+EnergyHessian energy_hessian_blocks(const Coefficients& c, const Mat3& F, const Mat3& S) {
   const double J = F.determinant();
   const double T = S.trace();
   const double e = trace_term(c.mu, J, S);
@@ -93,20 +88,36 @@ Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const 
   const Mat9 Q_F = inverse_derivative(F_inv);
   const Mat9 Q_S = inverse_derivative(S_inv);
   const Vec9 dlog_e_dS = -s / 3.0 + iota / T;  // ∂ ln e / ∂S
+  const Mat9 aa = a * a.transpose();
 
-  Mat27 h = Mat27::Zero();
+  EnergyHessian h;
   // ∂²/∂F²: trace term, −μ ln J, and λ/2 (J−1)², with dJ = J a and d²J = J (a aᵀ − Q_F).
-  h.block<9, 9>(0, 0) = e * (4.0 / 9.0 * a * a.transpose() - 2.0 / 3.0 * Q_F) + c.mu * Q_F +
-                        c.lambda * J * J * a * a.transpose() +
-                        c.lambda * (J - 1.0) * J * (a * a.transpose() - Q_F);
-  // ∂²/∂F∂S of the trace term.
-  h.block<9, 9>(0, 9) = e * 2.0 / 3.0 * a * dlog_e_dS.transpose();
-  h.block<9, 9>(9, 0) = h.block<9, 9>(0, 9).transpose();
-  // ∂²/∂S² of the trace term: e (∇ln e ∇ln eᵀ + ∇² ln e).
-  h.block<9, 9>(9, 9) = e * (dlog_e_dS * dlog_e_dS.transpose() + Q_S / 3.0 - iota * iota.transpose() / (T * T));
+  h.FF = (4.0 / 9.0 * e + c.lambda * J * J + c.lambda * (J - 1.0) * J) * aa +
+         (c.mu - 2.0 / 3.0 * e - c.lambda * (J - 1.0) * J) * Q_F;
+  // ∂²/∂F∂S and ∂²/∂S² of the trace term: e (∇ln e ∇ln eᵀ + ∇² ln e).
+  h.FS = e * 2.0 / 3.0 * a * dlog_e_dS.transpose();
+  h.SS = e * (dlog_e_dS * dlog_e_dS.transpose() + Q_S / 3.0 - iota * iota.transpose() / (T * T));
   // ∂²/∂ε² of the viscous term.
-  h.block<9, 9>(18, 18) = 2.0 * c.viscous * c.J_n * Mat9::Identity();
+  h.eps_eps = 2.0 * c.viscous * c.J_n;
   return h;
+}
+
+Vec27 energy_gradient(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps) {
+  const EnergyGradient g = energy_gradient_blocks(c, F, S, eps);
+  Vec27 y;
+  y << vec(g.F), vec(g.S), vec(g.eps);
+  return y;
+}
+
+Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3&) {
+  const EnergyHessian h = energy_hessian_blocks(c, F, S);
+  Mat27 m = Mat27::Zero();
+  m.block<9, 9>(0, 0) = h.FF;
+  m.block<9, 9>(0, 9) = h.FS;
+  m.block<9, 9>(9, 0) = h.FS.transpose();
+  m.block<9, 9>(9, 9) = h.SS;
+  m.block<9, 9>(18, 18) = h.eps_eps * Mat9::Identity();
+  return m;
 }
 
 Mat3 predicted_b_ob(const Mat3& S, const Mat3& A, double dt, double weissenberg) {
@@ -122,34 +133,35 @@ Mat3 elastic_left_cauchy_green(const Mat3& F, const Mat3& b_ob) {
 }  // namespace oldroyd_b
 
 namespace {
-// Jacobians of y = (F̂, Ŝ, ε̂) with respect to vec(A): dF̂ = dA F^n, dŜ = dA S + S dAᵀ,
-// dε̂ = (dA + dAᵀ)/(2Δt).
-Mat9 jacobian_F(const Mat3& F_n) {
-  Mat9 L = Mat9::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int b = 0; b < 3; ++b) L(vec_index(i, j), vec_index(i, b)) += F_n(b, j);
-  return L;
-}
-Mat9 jacobian_S(const Mat3& S) {
-  Mat9 L = Mat9::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int b = 0; b < 3; ++b) {
-        L(vec_index(i, j), vec_index(i, b)) += S(b, j);
-        L(vec_index(i, j), vec_index(j, b)) += S(i, b);
-      }
-  return L;
-}
-Mat9 jacobian_eps(double dt) {
-  Mat9 L = Mat9::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      L(vec_index(i, j), vec_index(i, j)) += 0.5 / dt;
-      L(vec_index(i, j), vec_index(j, i)) += 0.5 / dt;
+// The chain rule from y = (F̂, Ŝ, ε̂) to A. With dF̂ = dA F^n, dŜ = dA S + S dAᵀ and
+// dε̂ = (dA + dAᵀ)/(2Δt), left multiplication by the transposed Jacobian Lᵀ acts on each column
+// of a 9×N matrix reshaped as a 3×3 matrix C: C Fⁿᵀ, (C + Cᵀ) S, (C + Cᵀ)/(2Δt).
+enum class Strain { F, S, eps };
+
+struct ChainRule {
+  const Mat3& F_n;
+  const Mat3& S_n;
+  double dt;
+
+  Mat3 pull_back(Strain y, const Mat3& C) const {
+    switch (y) {
+      case Strain::F: return C * F_n.transpose();
+      case Strain::S: return (C + C.transpose()) * S_n;
+      case Strain::eps: return (C + C.transpose()) / (2.0 * dt);
     }
-  return L;
-}
+    return C;
+  }
+  // Lᵀ_y X, column by column.
+  Mat9 left(Strain y, const Mat9& X) const {
+    Mat9 out;
+    for (int k = 0; k < 9; ++k) out.col(k) = vec(pull_back(y, unvec(X.col(k))));
+    return out;
+  }
+  // Lᵀ_a X L_b.
+  Mat9 sandwich(Strain a, const Mat9& X, Strain b) const {
+    return left(a, left(b, X.transpose()).transpose());
+  }
+};
 }  // namespace
 
 OldroydB::OldroydB(std::string name, const OldroydBParameters& parameters)
@@ -181,20 +193,19 @@ bool OldroydB::evaluate(const particles::ParticleSet& particles, std::size_t p, 
   out.energy = volume * oldroyd_b::energy_density(c, F_hat, S_hat, eps_hat);
   if (order < 1) return true;
 
-  const Mat9 L_F = jacobian_F(F_n), L_S = jacobian_S(S_n), L_e = jacobian_eps(step.dt);
-  const oldroyd_b::Vec27 g = oldroyd_b::energy_gradient(c, F_hat, S_hat, eps_hat);
-  const Vec9 grad = L_F.transpose() * g.segment<9>(0) + L_S.transpose() * g.segment<9>(9) +
-                    L_e.transpose() * g.segment<9>(18);
-  out.gradient = volume * unvec(grad);
+  // ∂Φ/∂A = V Lᵀ ∂Ψ/∂y.
+  const ChainRule chain{F_n, S_n, step.dt};
+  const oldroyd_b::EnergyGradient g = oldroyd_b::energy_gradient_blocks(c, F_hat, S_hat, eps_hat);
+  out.gradient = volume * (chain.pull_back(Strain::F, g.F) + chain.pull_back(Strain::S, g.S) +
+                           chain.pull_back(Strain::eps, g.eps));
   if (order < 2) return true;
 
-  // Ŝ and F̂ are affine in A, so ∂²Φ/∂A² = Lᵀ (∂²Ψ/∂y²) L.
-  const oldroyd_b::Mat27 h = oldroyd_b::energy_hessian(c, F_hat, S_hat, eps_hat);
-  const Mat9 FF = h.block<9, 9>(0, 0), FS = h.block<9, 9>(0, 9), SS = h.block<9, 9>(9, 9),
-             EE = h.block<9, 9>(18, 18);
-  const Mat9 cross = L_F.transpose() * FS * L_S;
-  out.hessian = volume * (L_F.transpose() * FF * L_F + cross + cross.transpose() +
-                          L_S.transpose() * SS * L_S + L_e.transpose() * EE * L_e);
+  // F̂, Ŝ and ε̂ are affine in A, so ∂²Φ/∂A² = V Lᵀ (∂²Ψ/∂y²) L.
+  const oldroyd_b::EnergyHessian h = oldroyd_b::energy_hessian_blocks(c, F_hat, S_hat);
+  const Mat9 cross = chain.sandwich(Strain::F, h.FS, Strain::S);
+  out.hessian = volume * (chain.sandwich(Strain::F, h.FF, Strain::F) + cross + cross.transpose() +
+                          chain.sandwich(Strain::S, h.SS, Strain::S) +
+                          h.eps_eps * chain.sandwich(Strain::eps, Mat9::Identity(), Strain::eps));
   return true;
 }
 

@@ -11,30 +11,6 @@
 using namespace viscompm;
 
 namespace {
-// A small sponge with grips, a bullet and gravity: shared nodes, constraints, several materials.
-scene::SceneConfig sponge_scene() {
-  auto scene = testkit::base_scene(Vec3(1.0, 1.0, 0.6), 0.05);
-  scene.simulation.gravity = Vec3(0.0, -9.81, 0.0);
-  scene.simulation.max_time_step = 4e-3;
-  scene.newton.tolerance = 1e-10;
-  scene.materials.push_back(testkit::oldroyd_b_material("sponge", 1.0, 360.0, 1400.0, 1e-3, "paper", 50.0));
-  scene.materials.push_back(testkit::oldroyd_b_material("goo", 1.0, 20.0, 100.0, 0.5, "physical", 0.1));
-  scene.bodies.push_back(testkit::box_body("sponge", Vec3(0.35, 0.2, 0.2), Vec3(0.65, 0.8, 0.4), Vec3(0.3, 0, 0)));
-  auto goo = testkit::box_body("goo", Vec3(0.7, 0.3, 0.2), Vec3(0.85, 0.5, 0.4), Vec3(-0.5, 0.2, 0));
-  goo.angular_velocity = Vec3(0, 0, 3);
-  scene.bodies.push_back(goo);
-  scene.colliders.push_back(testkit::box_collider("bottom", "sticky", Vec3(0.3, 0.1, 0.15), Vec3(0.7, 0.25, 0.45)));
-  scene::ColliderSettings bullet;
-  bullet.name = "bullet";
-  bullet.shape = "sphere";
-  bullet.center = Vec3(0.25, 0.55, 0.3);
-  bullet.radius = 0.08;
-  bullet.contact = "slip";
-  bullet.velocity = Vec3(3, 0, 0);
-  scene.colliders.push_back(bullet);
-  return scene;
-}
-
 struct ParticleState {
   Vec3 x, v;
   Mat3 F, b, C;
@@ -81,7 +57,7 @@ MPI_Comm solo_communicator() {
 using Entries = std::vector<std::tuple<long long, long long, double>>;
 
 Entries first_newton_matrix(const parallel::Communicator& comm, std::int64_t& particle_count) {
-  simulation::Simulation sim(sponge_scene(), testkit::jacobi_cg(1e-12), comm);
+  simulation::Simulation sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-12), comm);
   auto& integrator = sim.integrator();
   integrator.build_layout(sim.particles());
   integrator.particles_to_grid(sim.particles());
@@ -118,13 +94,13 @@ TEST(ParallelAgreement, AssembledMatrixIsTheSameOnOneRankAndOnAll) {
 TEST(ParallelAgreement, FullStepsAreTheSameOnOneRankAndOnAll) {
   const parallel::Communicator world(MPI_COMM_WORLD);
   const double t_end = 0.02;  // several steps: migration, graph rebuilds, bullet contact
-  simulation::Simulation sim(sponge_scene(), testkit::jacobi_cg(1e-12), world);
+  simulation::Simulation sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-12), world);
   simulation::RunSummary summary;
   sim.advance_to(t_end, summary);
   const auto all = gather_particles(sim.particles(), world.comm());
   std::map<ParticleId, ParticleState> reference;
   if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
-    simulation::Simulation solo_sim(sponge_scene(), testkit::jacobi_cg(1e-12), parallel::Communicator(solo));
+    simulation::Simulation solo_sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-12), parallel::Communicator(solo));
     simulation::RunSummary solo_summary;
     solo_sim.advance_to(t_end, solo_summary);
     EXPECT_EQ(solo_summary.steps, summary.steps);

@@ -86,4 +86,28 @@ inline linalg::SolverConfiguration jacobi_cg(double tolerance) {
       "test solver");
 }
 
+// A small sponge with grips, a bullet and gravity: shared nodes, constraints, several materials.
+inline scene::SceneConfig sponge_scene() {
+  auto scene = base_scene(Vec3(1.0, 1.0, 0.6), 0.05);
+  scene.simulation.gravity = Vec3(0.0, -9.81, 0.0);
+  scene.simulation.max_time_step = 4e-3;
+  scene.newton.tolerance = 1e-10;
+  scene.materials.push_back(oldroyd_b_material("sponge", 1.0, 360.0, 1400.0, 1e-3, "paper", 50.0));
+  scene.materials.push_back(oldroyd_b_material("goo", 1.0, 20.0, 100.0, 0.5, "physical", 0.1));
+  scene.bodies.push_back(box_body("sponge", Vec3(0.35, 0.2, 0.2), Vec3(0.65, 0.8, 0.4), Vec3(0.3, 0, 0)));
+  auto goo = box_body("goo", Vec3(0.7, 0.3, 0.2), Vec3(0.85, 0.5, 0.4), Vec3(-0.5, 0.2, 0));
+  goo.angular_velocity = Vec3(0, 0, 3);
+  scene.bodies.push_back(goo);
+  scene.colliders.push_back(box_collider("bottom", "sticky", Vec3(0.3, 0.1, 0.15), Vec3(0.7, 0.25, 0.45)));
+  scene::ColliderSettings bullet;
+  bullet.name = "bullet";
+  bullet.shape = "sphere";
+  bullet.center = Vec3(0.25, 0.55, 0.3);
+  bullet.radius = 0.08;
+  bullet.contact = "slip";
+  bullet.velocity = Vec3(3, 0, 0);
+  scene.colliders.push_back(bullet);
+  return scene;
+}
+
 }  // namespace viscompm::testkit

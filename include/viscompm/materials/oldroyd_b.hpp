@@ -40,13 +40,26 @@ struct Coefficients {
   double J_n = 1.0;       ///< det(F^n): Φ^N integrates over the time-n volume V^n = J^n V^0
 };
 
+/// ∂Ψ/∂y as three matrices.
+struct EnergyGradient {
+  Mat3 F, S, eps;
+};
+/// The non-zero blocks of ∂²Ψ/∂y² (the ε block is a multiple of the identity).
+struct EnergyHessian {
+  Mat9 FF, FS, SS;
+  double eps_eps = 0.0;
+};
+
 /// det F > 0, det S > 0 and tr S > 0 (§5.7).
 bool feasible(const Mat3& F, const Mat3& S);
 /// Ψ(F, S, ε) of Appendix A with the constant of (5.8), so that Ψ(I, I, 0) = 0.
 double energy_density(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 /// ∂Ψ/∂y.
-Vec27 energy_gradient(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
+EnergyGradient energy_gradient_blocks(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 /// ∂²Ψ/∂y².
+EnergyHessian energy_hessian_blocks(const Coefficients& c, const Mat3& F, const Mat3& S);
+/// The same as 27-vectors and 27×27 matrices over y = (vec F, vec S, vec ε).
+Vec27 energy_gradient(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 
 /// Ŝ(A) of (5.14): S + A S + S A^T + (Δt/Wi)(I − S).
