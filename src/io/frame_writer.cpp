@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <type_traits>
 
 #include "viscompm/core/error.hpp"
 
@@ -105,16 +106,22 @@ FrameInfo write_frame(const std::string& directory, FrameInfo info, const partic
   const std::size_t n = particles.size();
   const auto rows = static_cast<hsize_t>(n_local), start = static_cast<hsize_t>(offset),
              total = static_cast<hsize_t>(n_total);
-  write_rows(group, "id", H5T_NATIVE_INT64, particles.id, {}, rows, start, total);
-  write_rows(group, "position", H5T_NATIVE_DOUBLE, vectors(particles.position), {3}, rows, start, total);
-  write_rows(group, "velocity", H5T_NATIVE_DOUBLE, vectors(particles.velocity), {3}, rows, start, total);
-  write_rows(group, "mass", H5T_NATIVE_DOUBLE, particles.mass, {}, rows, start, total);
-  write_rows(group, "volume0", H5T_NATIVE_DOUBLE, particles.volume0, {}, rows, start, total);
-  write_rows(group, "material_id", H5T_NATIVE_INT, particles.material_id, {}, rows, start, total);
-  write_rows(group, "deformation_gradient", H5T_NATIVE_DOUBLE,
-             tensors(n, [&](std::size_t p) { return particles.deformation_gradient[p]; }), {3, 3}, rows, start, total);
-  write_rows(group, "left_cauchy_green_ob", H5T_NATIVE_DOUBLE,
-             tensors(n, [&](std::size_t p) { return particles.left_cauchy_green_ob[p]; }), {3, 3}, rows, start, total);
+  // Every stored per-particle quantity, then b^E of (5.5) computed by each particle's material.
+  particles.for_each_field([&](const char* name, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    if constexpr (std::is_same_v<T, Vec3>) {
+      write_rows(group, name, H5T_NATIVE_DOUBLE, vectors(field), {3}, rows, start, total);
+    } else if constexpr (std::is_same_v<T, Mat3>) {
+      write_rows(group, name, H5T_NATIVE_DOUBLE, tensors(n, [&](std::size_t p) { return field[p]; }), {3, 3}, rows,
+                 start, total);
+    } else if constexpr (std::is_same_v<T, ParticleId>) {
+      write_rows(group, name, H5T_NATIVE_INT64, field, {}, rows, start, total);
+    } else if constexpr (std::is_same_v<T, int>) {
+      write_rows(group, name, H5T_NATIVE_INT, field, {}, rows, start, total);
+    } else {
+      write_rows(group, name, H5T_NATIVE_DOUBLE, field, {}, rows, start, total);
+    }
+  });
   write_rows(group, "left_cauchy_green_elastic", H5T_NATIVE_DOUBLE, tensors(n, [&](std::size_t p) {
                return materials[particles.material_id[p]]->left_cauchy_green_elastic(particles, p);
              }), {3, 3}, rows, start, total);
@@ -159,17 +166,21 @@ void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& fram
           << "    <Time Value=\"" << std::setprecision(17) << f.time << "\"/>\n"
           << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\" NodesPerElement=\"1\"/>\n"
           << "    <Geometry GeometryType=\"XYZ\">" << item("position", n3, "Float", 8) << "</Geometry>\n";
-      auto attribute = [&](const char* name, const char* type, const std::string& dataset, const std::string& dims,
+      auto attribute = [&](const std::string& name, const char* type, const std::string& dataset, const std::string& dims,
                            const char* number, int precision) {
         out << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << type << "\" Center=\"Node\">"
             << item(dataset, dims, number, precision) << "</Attribute>\n";
       };
-      attribute("id", "Scalar", "id", n1, "Int", 8);
-      attribute("velocity", "Vector", "velocity", n3, "Float", 8);
-      attribute("mass", "Scalar", "mass", n1, "Float", 8);
-      attribute("material_id", "Scalar", "material_id", n1, "Int", 4);
-      attribute("deformation_gradient", "Tensor", "deformation_gradient", n33, "Float", 8);
-      attribute("left_cauchy_green_ob", "Tensor", "left_cauchy_green_ob", n33, "Float", 8);
+      // One attribute per stored field (position is the geometry), and b^E.
+      particles::ParticleSet().for_each_field([&](const char* name, const auto& field) {
+        using T = typename std::decay_t<decltype(field)>::value_type;
+        if (std::string(name) == "position") return;
+        if constexpr (std::is_same_v<T, Vec3>) attribute(name, "Vector", name, n3, "Float", 8);
+        else if constexpr (std::is_same_v<T, Mat3>) attribute(name, "Tensor", name, n33, "Float", 8);
+        else if constexpr (std::is_same_v<T, ParticleId>) attribute(name, "Scalar", name, n1, "Int", 8);
+        else if constexpr (std::is_same_v<T, int>) attribute(name, "Scalar", name, n1, "Int", 4);
+        else attribute(name, "Scalar", name, n1, "Float", 8);
+      });
       attribute("left_cauchy_green_elastic", "Tensor", "left_cauchy_green_elastic", n33, "Float", 8);
       out << "   </Grid>\n";
     }

@@ -22,7 +22,9 @@ struct FrameInfo {
 
 std::string frame_file_name(int frame);
 
-/// Writes DIR/frame_NNNNN.h5 collectively. Rows are in rank order; `id` identifies particles.
+/// Writes DIR/frame_NNNNN.h5 collectively: every field of ParticleSet::for_each_field under
+/// /particles (plus left_cauchy_green_elastic from each material). Rows are in rank order;
+/// `id` identifies particles.
 /// Returns the frame's info with the global particle count.
 FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
                       const materials::MaterialList& materials, const parallel::Communicator& comm);
