@@ -5,6 +5,7 @@
 #include <BelosSolverManager.hpp>
 #include <BelosTpetraAdapter.hpp>
 
+#include "hessian_operator.hpp"
 #include "solver_configuration_impl.hpp"
 #include "viscompm/linalg/linalg_types.hpp"
 
@@ -20,8 +21,8 @@ struct NearNullspace {
 class Preconditioner {
  public:
   virtual ~Preconditioner() = default;
-  /// Builds (pattern_changed) or refreshes the preconditioner for the values of A.
-  virtual void setup(const Teuchos::RCP<crs_matrix_type>& A, bool pattern_changed, const NearNullspace& modes) = 0;
+  /// Builds (pattern_changed) or refreshes the preconditioner for the current values of H.
+  virtual void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace& modes) = 0;
   /// The operator to apply, null for no preconditioning.
   virtual Teuchos::RCP<operator_type> op() const = 0;
 };

@@ -17,10 +17,12 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
     ParameterTable<SolverSettings> table;
     using S = SolverSettings;
     table.string(&S::label, "Label", "", {}, "name of this configuration in solver.csv and study.csv")
+        .string(&S::operator_form, "Operator", "assembled", {"assembled", "matrix-free"},
+                "assembled Tpetra matrix, or the paper's matrix-free Hessian-vector product (§5.7)")
         .string(&S::krylov_solver, "Krylov solver", "Pseudo Block CG", {"Pseudo Block CG", "Block CG"},
                 "Belos solver (Pseudo Block CG is Belos' CG)")
-        .string(&S::preconditioner, "Preconditioner", "Ifpack2", {"none", "Ifpack2", "MueLu"},
-                "preconditioner package")
+        .string(&S::preconditioner, "Preconditioner", "Ifpack2", {"none", "Jacobi", "Ifpack2", "MueLu"},
+                "none; Jacobi (exact diagonal of H, also matrix-free); Ifpack2 or MueLu (assembled only)")
         .string(&S::ifpack2_type, "Ifpack2 type", "RELAXATION", {}, "Ifpack2::Factory name (RELAXATION, CHEBYSHEV, ...)");
     return table;
   }();
@@ -64,13 +66,24 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   auto solver = factory.create(s.krylov_solver, Teuchos::null);
   check_known(*impl->krylov_parameters, *solver->getValidParameters(), origin, krylov_sublist);
 
+  if (s.operator_form == "matrix-free" && (s.preconditioner == "Ifpack2" || s.preconditioner == "MueLu"))
+    throw InputError(origin + ": parameter 'Preconditioner': " + s.preconditioner +
+                     " needs the assembled matrix (Operator = assembled)");
   if (s.preconditioner == "Ifpack2") {
     Teuchos::ParameterList valid;
     Ifpack2::getValidParameters(valid);
+    // AdditiveSchwarz reads its inner preconditioner under names Ifpack2's list omits.
+    for (const char* name : {"inner preconditioner name", "subdomain solver name", "schwarz: inner preconditioner name",
+                             "schwarz: subdomain solver name"})
+      valid.set(name, std::string());
+    for (const char* name : {"inner preconditioner parameters", "subdomain solver parameters",
+                             "schwarz: inner preconditioner parameters", "schwarz: subdomain solver parameters"})
+      valid.sublist(name);
     check_known(*impl->preconditioner_parameters, valid, origin, preconditioner_sublist);
   }
   if (s.label.empty()) {
-    s.label = s.preconditioner == "Ifpack2" ? "Ifpack2 " + s.ifpack2_type : s.preconditioner;
+    s.label = (s.operator_form == "matrix-free" ? "matrix-free " : "") +
+              (s.preconditioner == "Ifpack2" ? "Ifpack2 " + s.ifpack2_type : s.preconditioner);
     if (impl->preconditioner_parameters->isParameter("relaxation: type"))
       s.label += " " + impl->preconditioner_parameters->get<std::string>("relaxation: type");
   }

@@ -6,113 +6,34 @@
 #include <chrono>
 
 #include "krylov.hpp"
-#include "node_space_impl.hpp"
+#include "hessian_operator.hpp"
 
 namespace viscompm::linalg {
 
 struct NewtonSystem::Impl {
   Impl(const NodeSpace& s, const SolverConfiguration& c)
-      : space(s), config(c), preconditioner(make_preconditioner(c)), krylov(c) {}
+      : space(s),
+        config(c),
+        hessian(c.impl().settings.operator_form == "matrix-free" ? make_matrix_free_hessian(s) : make_assembled_hessian(s)),
+        preconditioner(make_preconditioner(c)),
+        krylov(c) {}
 
   const NodeSpace& space;
   SolverConfiguration config;
+  std::unique_ptr<HessianOperator> hessian;
   std::unique_ptr<Preconditioner> preconditioner;
   KrylovSolver krylov;
-
-  std::vector<NodeId> graph_cells;  // occupied cells the graph was built for
-  std::uint64_t graph_space_version = 0;
-  int graph_builds = 0;
-  bool pattern_changed = true;      // since the last preconditioner set-up
+  bool pattern_changed = true;  // since the last preconditioner set-up
   bool values_changed = true;
   double assembly_seconds = 0.0;
-  Teuchos::RCP<fe_graph_type> graph;
-  Teuchos::RCP<fe_matrix_type> matrix;
   NearNullspace modes;
-  std::vector<local_ordinal_type> local_to_column;
-  // For cell c and stencil nodes (a, b): where node b's three columns start in the rows of node
-  // a, relative to the row start (the three rows of a node share one column pattern).
-  std::vector<int> cell_offsets;
+  std::uint64_t modes_version = 0;
 
-  void build_graph(const grid::GridLayout& layout);
   void build_near_nullspace(const grid::GridLayout& layout);
+  // Owned entries of a node field into a Tpetra vector on the owned dofs, and back.
+  void to_owned(const NodeVectorField& field, multivector_type& owned) const;
+  void from_owned(const multivector_type& owned, NodeVectorField& field) const;
 };
-
-void NewtonSystem::Impl::build_graph(const grid::GridLayout& layout) {
-  const auto& s = space.impl();
-  const std::size_t n = layout.local_node_count();
-  const int K = layout.nodes_per_cell();
-  // Neighbours of every local node: the union of the stencils of the cells containing it.
-  std::vector<std::vector<int>> neighbours(n);
-  for (std::size_t c = 0; c < layout.cell_count(); ++c) {
-    const int* nodes = layout.nodes_of_cell(c);
-    for (int a = 0; a < K; ++a) neighbours[nodes[a]].insert(neighbours[nodes[a]].end(), nodes, nodes + K);
-  }
-  Kokkos::DualView<std::size_t*, fe_graph_type::device_type> counts("entries per row", 3 * n);
-  auto host_counts = counts.h_view;
-  for (std::size_t i = 0; i < n; ++i) {
-    auto& nb = neighbours[i];
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-    for (int d = 0; d < 3; ++d) host_counts(3 * i + d) = 3 * nb.size();
-  }
-  counts.modify_host();
-  counts.sync_device();
-
-  // Globally indexed: an owner receives columns from the other ranks' shared rows that it does
-  // not hold itself, so the column map must come from fillComplete, not from our local nodes.
-  graph = Teuchos::rcp(new fe_graph_type(s.owned_dof_map, s.local_dof_map,
-                                         Kokkos::DualView<const std::size_t*, fe_graph_type::device_type>(counts),
-                                         s.dof_import));
-  graph->beginAssembly();
-  std::vector<global_ordinal_type> columns;
-  const auto& local_dofs = *s.local_dof_map;
-  for (std::size_t i = 0; i < n; ++i) {
-    columns.clear();
-    for (int j : neighbours[i])
-      for (int d = 0; d < 3; ++d) columns.push_back(local_dofs.getGlobalElement(3 * j + d));
-    for (int d = 0; d < 3; ++d)
-      graph->insertGlobalIndices(local_dofs.getGlobalElement(static_cast<local_ordinal_type>(3 * i + d)),
-                                 static_cast<local_ordinal_type>(columns.size()), columns.data());
-  }
-  graph->endAssembly();
-  matrix = Teuchos::rcp(new fe_matrix_type(graph));
-  // Our local dof → column index of the owned+shared matrix that assembly writes into.
-  matrix->beginAssembly();
-  const auto column_map = matrix->getColMap();
-  local_to_column.resize(3 * n);
-  for (std::size_t r = 0; r < 3 * n; ++r)
-    local_to_column[r] = column_map->getLocalElement(local_dofs.getGlobalElement(static_cast<local_ordinal_type>(r)));
-  const auto local_matrix = matrix->getLocalMatrixHost();
-  const auto& row_map = local_matrix.graph.row_map;
-  const auto& entries = local_matrix.graph.entries;
-  cell_offsets.resize(layout.cell_count() * K * K);
-  for (std::size_t c = 0; c < layout.cell_count(); ++c) {
-    const int* nodes = layout.nodes_of_cell(c);
-    for (int a = 0; a < K; ++a) {
-      for (int d = 0; d < 3; ++d) {
-        const auto row = 3 * nodes[a] + d;
-        const auto* first = entries.data() + row_map(row);
-        const auto* last = entries.data() + row_map(row + 1);
-        for (int b = 0; b < K; ++b) {
-          const local_ordinal_type column = local_to_column[3 * nodes[b]];
-          const auto* at = std::lower_bound(first, last, column);
-          if (at + 2 >= last || at[0] != column || at[1] != column + 1 || at[2] != column + 2)
-            throw std::logic_error("NewtonSystem: a node's three columns are not contiguous in its rows");
-          const int offset = static_cast<int>(at - first);
-          if (d == 0) cell_offsets[(c * K + a) * K + b] = offset;
-          else if (cell_offsets[(c * K + a) * K + b] != offset)
-            throw std::logic_error("NewtonSystem: the rows of a node differ in their columns");
-        }
-      }
-    }
-  }
-  matrix->endAssembly();
-  graph_cells = layout.cells;
-  graph_space_version = space.version();
-  ++graph_builds;
-  pattern_changed = true;
-  build_near_nullspace(layout);
-}
 
 void NewtonSystem::Impl::build_near_nullspace(const grid::GridLayout& layout) {
   const auto& s = space.impl();
@@ -132,6 +53,21 @@ void NewtonSystem::Impl::build_near_nullspace(const grid::GridLayout& layout) {
     rbm(3 * i + 0, 4) = x.z();  rbm(3 * i + 2, 4) = -x.x();
     rbm(3 * i + 0, 5) = -x.y(); rbm(3 * i + 1, 5) = x.x();
   }
+  modes_version = space.version();
+}
+
+void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
+  auto view = owned.getLocalViewHost(Tpetra::Access::OverwriteAll);
+  const double* data = field.data()->data();
+  for (std::size_t r = 0; r < 3 * space.impl().owned_count; ++r) view(r, 0) = data[r];
+}
+
+void NewtonSystem::Impl::from_owned(const multivector_type& owned, NodeVectorField& field) const {
+  field.assign(space.impl().local_nodes.size(), Vec3::Zero());
+  auto view = owned.getLocalViewHost(Tpetra::Access::ReadOnly);
+  double* data = field.data()->data();
+  for (std::size_t r = 0; r < 3 * space.impl().owned_count; ++r) data[r] = view(r, 0);
+  space.distribute(field);
 }
 
 NewtonSystem::NewtonSystem(const NodeSpace& space, const SolverConfiguration& config)
@@ -143,47 +79,8 @@ void NewtonSystem::assemble(const implicit::IncrementalPotential& potential, con
                             bool project) {
   Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  const grid::GridLayout& layout = potential.layout();
-  const bool rebuild = m.graph.is_null() || m.space.version() != m.graph_space_version ||
-                       m.space.comm().any(layout.cells != m.graph_cells);
-  if (rebuild) {
-    static const auto graph_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3f newton graph");
-    Teuchos::TimeMonitor timer(*graph_timer);
-    m.build_graph(layout);
-  }
-
-  m.matrix->beginAssembly();
-  m.matrix->setAllToScalar(0.0);  // beginAssembly keeps old values
-  const int K = layout.nodes_per_cell();
-  // Element blocks go straight into the values of the owned+shared matrix, at offsets found
-  // when the graph was built (no per-entry column search).
-  const auto local_matrix = m.matrix->getLocalMatrixHost();
-  const auto& row_map = local_matrix.graph.row_map;
-  double* values = local_matrix.values.data();
-  potential.element_hessians(v, project, [&](std::size_t c, const implicit::ElementMatrix& element) {
-    const int* nodes = layout.nodes_of_cell(c);
-    const int* offsets = m.cell_offsets.data() + c * K * K;
-    for (int a = 0; a < K; ++a)
-      for (int d = 0; d < 3; ++d) {
-        // Row 3a+d of the symmetric element is its column 3a+d.
-        const double* row_values = element.col(3 * a + d).data();
-        double* row = values + row_map(3 * nodes[a] + d);
-        for (int b = 0; b < K; ++b) {
-          double* target = row + offsets[a * K + b];
-          target[0] += row_values[3 * b];
-          target[1] += row_values[3 * b + 1];
-          target[2] += row_values[3 * b + 2];
-        }
-      }
-  });
-  // Inertia: m_i on the diagonal of owned rows.
-  for (std::size_t i = 0; i < layout.owned_count; ++i)
-    for (int d = 0; d < 3; ++d) {
-      const local_ordinal_type row = static_cast<local_ordinal_type>(3 * i + d);
-      const double mass = potential.mass()[i];
-      m.matrix->sumIntoLocalValues(row, 1, &mass, &m.local_to_column[row]);
-    }
-  m.matrix->endAssembly();
+  if (m.hessian->update(potential, v, project)) m.pattern_changed = true;
+  if (m.modes_version != m.space.version()) m.build_near_nullspace(potential.layout());
   m.values_changed = true;
   m.assembly_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -192,18 +89,14 @@ LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorFiel
   Impl& m = *impl_;
   const auto& s = m.space.impl();
   multivector_type b(s.owned_dof_map, 1), x(s.owned_dof_map, 1);
-  {
-    auto view = b.getLocalViewHost(Tpetra::Access::OverwriteAll);
-    const double* data = rhs.data()->data();
-    for (std::size_t r = 0; r < 3 * s.owned_count; ++r) view(r, 0) = data[r];
-  }
+  m.to_owned(rhs, b);
   static const auto setup_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3b newton precondition");
   static const auto cg_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3c newton cg");
   double setup_seconds = 0.0;
   if (m.values_changed) {
     Teuchos::TimeMonitor timer(*setup_timer);
     const auto start = std::chrono::steady_clock::now();
-    m.preconditioner->setup(m.matrix, m.pattern_changed, m.modes);
+    m.preconditioner->setup(*m.hessian, m.pattern_changed, m.modes);
     setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     m.pattern_changed = false;
     m.values_changed = false;
@@ -211,33 +104,35 @@ LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorFiel
   LinearSolveReport report;
   {
     Teuchos::TimeMonitor timer(*cg_timer);
-    report = m.krylov.solve(m.matrix, m.preconditioner->op(), x, b);
+    report = m.krylov.solve(m.hessian->op(), m.preconditioner->op(), x, b);
   }
   report.setup_seconds = setup_seconds;
-  dv.assign(rhs.size(), Vec3::Zero());
-  {
-    auto view = x.getLocalViewHost(Tpetra::Access::ReadOnly);
-    double* data = dv.data()->data();
-    for (std::size_t r = 0; r < 3 * s.owned_count; ++r) data[r] = view(r, 0);
-  }
-  m.space.distribute(dv);
+  m.from_owned(x, dv);
   return report;
 }
 
+void NewtonSystem::apply(const NodeVectorField& x, NodeVectorField& y) const {
+  const Impl& m = *impl_;
+  multivector_type X(m.space.impl().owned_dof_map, 1), Y(m.space.impl().owned_dof_map, 1);
+  m.to_owned(x, X);
+  m.hessian->op()->apply(X, Y);
+  m.from_owned(Y, y);
+}
+
 std::int64_t NewtonSystem::global_rows() const {
-  return static_cast<std::int64_t>(impl_->matrix->getGlobalNumRows());
+  return static_cast<std::int64_t>(impl_->space.impl().owned_dof_map->getGlobalNumElements());
 }
 
-std::int64_t NewtonSystem::global_nonzeros() const {
-  return static_cast<std::int64_t>(impl_->matrix->getGlobalNumEntries());
-}
-
+std::int64_t NewtonSystem::global_nonzeros() const { return impl_->hessian->nonzeros(); }
+bool NewtonSystem::matrix_free() const { return impl_->hessian->matrix().is_null(); }
 double NewtonSystem::assembly_seconds() const { return impl_->assembly_seconds; }
-int NewtonSystem::graph_builds() const { return impl_->graph_builds; }
+int NewtonSystem::graph_builds() const { return impl_->hessian->pattern_builds(); }
 const SolverConfiguration& NewtonSystem::configuration() const { return impl_->config; }
 
 std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entries() const {
-  const auto& A = *impl_->matrix;
+  const auto matrix = impl_->hessian->matrix();
+  if (matrix.is_null()) throw std::logic_error("gather_entries: the operator is matrix-free");
+  const auto& A = *matrix;
   std::vector<double> local;  // (row, column, value) triplets as doubles (exact below 2^53)
   const auto row_map = A.getRowMap();
   const auto col_map = A.getColMap();
@@ -266,7 +161,9 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
 }
 
 void NewtonSystem::write_matrix_market(const std::string& file) const {
-  Tpetra::MatrixMarket::Writer<crs_matrix_type>::writeSparseFile(file, impl_->matrix);
+  const auto matrix = impl_->hessian->matrix();
+  if (matrix.is_null()) throw std::logic_error("write_matrix_market: the operator is matrix-free");
+  Tpetra::MatrixMarket::Writer<crs_matrix_type>::writeSparseFile(file, matrix);
 }
 
 }  // namespace viscompm::linalg

@@ -11,21 +11,53 @@ namespace viscompm::linalg {
 namespace {
 class NoPreconditioner : public Preconditioner {
  public:
-  void setup(const Teuchos::RCP<crs_matrix_type>&, bool, const NearNullspace&) override {}
+  void setup(const HessianOperator&, bool, const NearNullspace&) override {}
   Teuchos::RCP<operator_type> op() const override { return Teuchos::null; }
+};
+
+// Jacobi from the exact diagonal of H, assembled or matrix-free (the paper's preconditioner).
+class JacobiPreconditioner : public Preconditioner {
+ public:
+  void setup(const HessianOperator& H, bool, const NearNullspace&) override {
+    auto inverse = Teuchos::rcp(new vector_type(*H.diagonal(), Teuchos::Copy));
+    inverse->reciprocal(*inverse);
+    op_ = Teuchos::rcp(new InverseDiagonal(inverse));
+  }
+  Teuchos::RCP<operator_type> op() const override { return op_; }
+
+ private:
+  class InverseDiagonal : public operator_type {
+   public:
+    explicit InverseDiagonal(Teuchos::RCP<vector_type> d) : d_(std::move(d)) {}
+    Teuchos::RCP<const map_type> getDomainMap() const override { return d_->getMap(); }
+    Teuchos::RCP<const map_type> getRangeMap() const override { return d_->getMap(); }
+    void apply(const multivector_type& X, multivector_type& Y, Teuchos::ETransp, scalar_type alpha,
+               scalar_type beta) const override {
+      Y.elementWiseMultiply(alpha, *d_, X, beta);  // Y = α D⁻¹ X + β Y
+    }
+
+   private:
+    Teuchos::RCP<vector_type> d_;
+  };
+  Teuchos::RCP<operator_type> op_;
 };
 
 class Ifpack2Preconditioner : public Preconditioner {
  public:
   explicit Ifpack2Preconditioner(const SolverConfiguration& config) : config_(config) {}
-  void setup(const Teuchos::RCP<crs_matrix_type>& A, bool pattern_changed, const NearNullspace&) override {
+  void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace&) override {
+    const Teuchos::RCP<crs_matrix_type> A = H.matrix();
     if (pattern_changed || prec_.is_null()) {
       prec_ = Ifpack2::Factory::create<Tpetra::RowMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>>(
           config_.impl().settings.ifpack2_type, A);
       if (prec_.is_null())
         throw InputError(config_.origin() + ": parameter 'Ifpack2 type': unknown Ifpack2 preconditioner '" +
                          config_.impl().settings.ifpack2_type + "'");
-      prec_->setParameters(*config_.impl().preconditioner_parameters);
+      Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
+      // 3×3 point-block relaxation: one block per node (a node's three dofs are consecutive).
+      if (config_.impl().settings.ifpack2_type == "BLOCK_RELAXATION" && !params.isParameter("partitioner: local parts"))
+        params.set("partitioner: local parts", static_cast<local_ordinal_type>(A->getNodeNumRows() / 3));
+      prec_->setParameters(params);
       prec_->initialize();
     }
     prec_->compute();  // new values, same pattern
@@ -40,7 +72,8 @@ class Ifpack2Preconditioner : public Preconditioner {
 class MueLuPreconditioner : public Preconditioner {
  public:
   explicit MueLuPreconditioner(const SolverConfiguration& config) : config_(config) {}
-  void setup(const Teuchos::RCP<crs_matrix_type>& A, bool pattern_changed, const NearNullspace& modes) override {
+  void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace& modes) override {
+    const Teuchos::RCP<crs_matrix_type> A = H.matrix();
     const bool reuse = config_.impl().preconditioner_parameters->get<std::string>("reuse: type", "none") != "none";
     if (!pattern_changed && reuse && !prec_.is_null()) {
       MueLu::ReuseTpetraPreconditioner(A, *prec_);
@@ -65,6 +98,7 @@ std::unique_ptr<Preconditioner> make_preconditioner(const SolverConfiguration& c
   const std::string& kind = config.impl().settings.preconditioner;
   if (kind == "Ifpack2") return std::make_unique<Ifpack2Preconditioner>(config);
   if (kind == "MueLu") return std::make_unique<MueLuPreconditioner>(config);
+  if (kind == "Jacobi") return std::make_unique<JacobiPreconditioner>();
   return std::make_unique<NoPreconditioner>();
 }
 

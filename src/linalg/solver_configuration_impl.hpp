@@ -11,6 +11,7 @@ namespace viscompm::linalg {
 /// The top level of a solver file.
 struct SolverSettings {
   std::string label;
+  std::string operator_form = "assembled";
   std::string krylov_solver = "Pseudo Block CG";
   std::string preconditioner = "Ifpack2";
   std::string ifpack2_type = "RELAXATION";

@@ -1,7 +1,8 @@
-// The Newton matrix H = M + Δt² ∇²Φ assembled from per-cell element matrices into a Tpetra
+// The Newton matrix H = M + Δt² ∇²Φ and its solve with Belos CG and the configured
+// preconditioner. H is either assembled from per-cell element matrices into a Tpetra
 // FECrsMatrix (owned and shared rows, zeroed each assembly, shared rows summed into their
-// owners), and its solve with Belos CG and the configured preconditioner. The graph is built
-// once per set of occupied cells and reused while the particles keep the same cells.
+// owners; the graph is built once per set of occupied cells and reused while the particles keep
+// the same cells), or applied matrix-free from the same per-particle pieces (the paper's §5.7).
 #pragma once
 
 #include <cstdint>
@@ -30,8 +31,13 @@ class NewtonSystem {
   /// returned on all local nodes. Sets up the preconditioner first if H changed.
   LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv);
 
+  /// y = H x (x and y on all local nodes; owned entries of x are used). Collective.
+  void apply(const NodeVectorField& x, NodeVectorField& y) const;
+
   std::int64_t global_rows() const;
+  /// Entries of the assembled matrix; -1 when matrix-free.
   std::int64_t global_nonzeros() const;
+  bool matrix_free() const;
   /// Seconds spent in the last assemble().
   double assembly_seconds() const;
   /// How many times the graph has been built.

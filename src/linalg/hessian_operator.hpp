@@ -1,0 +1,35 @@
+// The Newton matrix H = M + Δt² ∇²Φ as a Tpetra operator, in two forms built from the same
+// per-particle pieces: assembled into an FECrsMatrix, or applied matrix-free (the paper's §5.7
+// solver). Private to src/linalg.
+#pragma once
+
+#include <memory>
+
+#include "node_space_impl.hpp"
+#include "viscompm/implicit/incremental_potential.hpp"
+
+namespace viscompm::linalg {
+
+class HessianOperator {
+ public:
+  virtual ~HessianOperator() = default;
+  /// Prepares H at grid velocities v (collective). Returns true if its sparsity pattern changed.
+  virtual bool update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) = 0;
+  virtual Teuchos::RCP<const operator_type> op() const = 0;
+  /// The assembled matrix, or null when matrix-free.
+  virtual Teuchos::RCP<crs_matrix_type> matrix() const = 0;
+  /// diag(H) on the owned dofs (exact in both forms).
+  virtual Teuchos::RCP<const vector_type> diagonal() const = 0;
+  /// Global number of entries of H's sparsity pattern (the assembled one, also when matrix-free).
+  virtual std::int64_t nonzeros() const = 0;
+  /// How many times a sparsity pattern was built.
+  virtual int pattern_builds() const = 0;
+};
+
+std::unique_ptr<HessianOperator> make_assembled_hessian(const NodeSpace& space);
+std::unique_ptr<HessianOperator> make_matrix_free_hessian(const NodeSpace& space);
+
+/// Neighbours of every local node: the union of the stencils of the cells containing it (sorted).
+std::vector<std::vector<int>> node_neighbours(const grid::GridLayout& layout);
+
+}  // namespace viscompm::linalg

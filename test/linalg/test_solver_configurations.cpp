@@ -1,0 +1,113 @@
+// Every solver configuration in inputs/solvers/ solves a small sponge Newton system on 1 and 2
+// ranks with the same iteration count (±10 %), and the matrix-free Hessian equals the assembled
+// one on random vectors.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include "scenes.hpp"
+#include "viscompm/simulation/simulation.hpp"
+
+using namespace viscompm;
+
+namespace {
+std::vector<std::string> solver_files() {
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(VISCOMPM_SOURCE_DIR "/inputs/solvers"))
+    if (e.path().extension() == ".xml") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+MPI_Comm solo_communicator() {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm solo;
+  MPI_Comm_split(MPI_COMM_WORLD, rank == 0 ? 0 : MPI_UNDEFINED, 0, &solo);
+  return solo;
+}
+
+// A Newton system of the small sponge with moving parts at a Δt of several elastic CFL limits,
+// solved from zero with `config`; returns the report of the solve.
+linalg::LinearSolveReport solve_sponge_system(const linalg::SolverConfiguration& config,
+                                              const parallel::Communicator& comm) {
+  simulation::Simulation sim(testkit::sponge_scene(), config, comm);
+  auto& integrator = sim.integrator();
+  integrator.build_layout(sim.particles());
+  integrator.particles_to_grid(sim.particles());
+  const auto objective = integrator.build_objective(sim.particles(), 0.0, 4e-3);
+  NodeVectorField g;
+  EXPECT_TRUE(objective->potential->gradient(objective->initial_guess, g));
+  integrator.node_space().accumulate(g);
+  for (Vec3& x : g) x = -x;
+  auto& system = integrator.newton_system();
+  system.assemble(*objective->potential, objective->initial_guess, true);
+  NodeVectorField dv;
+  return system.solve(g, dv);
+}
+}  // namespace
+
+TEST(SolverConfigurations, EverySolverFileConvergesWithTheSameIterationsOnOneRankAndAll) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const auto files = solver_files();
+  ASSERT_GE(files.size(), 8u);
+  for (const auto& file : files) {
+    const auto config = linalg::SolverConfiguration::read(file);
+    const auto report = solve_sponge_system(config, world);
+    EXPECT_TRUE(report.converged) << file;
+    EXPECT_LT(report.relative_residual, 1e-5) << file;
+    EXPECT_GT(report.iterations, 0) << file;
+    int reference_iterations = report.iterations;
+    if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
+      reference_iterations = solve_sponge_system(config, parallel::Communicator(solo)).iterations;
+      MPI_Comm_free(&solo);
+    }
+    MPI_Bcast(&reference_iterations, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (config.label() == "ifpack2-sgs") {
+      // Ifpack2's Gauss-Seidel is hybrid: Gauss-Seidel within a rank, Jacobi between ranks. It
+      // cannot match one rank; it must stay between true SGS and Jacobi (45 iterations here).
+      EXPECT_GE(report.iterations, reference_iterations) << file;
+      EXPECT_LT(report.iterations, 1.5 * reference_iterations) << file;
+    } else {
+      EXPECT_NEAR(report.iterations, reference_iterations, 0.1 * reference_iterations + 1)
+          << file << ": " << world.size() << " ranks vs 1";
+    }
+    if (world.is_root())
+      std::cout << "  " << config.label() << ": " << report.iterations << " iterations (1 rank: "
+                << reference_iterations << ")\n";
+  }
+}
+
+TEST(SolverConfigurations, MatrixFreeHessianEqualsTheAssembledOneOnRandomVectors) {
+  const parallel::Communicator comm(MPI_COMM_WORLD);
+  simulation::Simulation sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-8), comm);
+  auto& integrator = sim.integrator();
+  integrator.build_layout(sim.particles());
+  integrator.particles_to_grid(sim.particles());
+  const auto objective = integrator.build_objective(sim.particles(), 0.0, 4e-3);
+  linalg::NewtonSystem assembled(integrator.node_space(),
+                                 linalg::SolverConfiguration::read(VISCOMPM_SOURCE_DIR "/inputs/solvers/jacobi_cg.xml"));
+  linalg::NewtonSystem matrix_free(
+      integrator.node_space(), linalg::SolverConfiguration::read(VISCOMPM_SOURCE_DIR "/inputs/solvers/matrix_free_jacobi_cg.xml"));
+  ASSERT_TRUE(matrix_free.matrix_free());
+  std::mt19937 rng(7 + comm.rank());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (bool project : {false, true}) {
+    assembled.assemble(*objective->potential, objective->initial_guess, project);
+    matrix_free.assemble(*objective->potential, objective->initial_guess, project);
+    for (int trial = 0; trial < 3; ++trial) {
+      NodeVectorField x(integrator.layout().local_node_count()), y_assembled, y_matrix_free;
+      for (auto& xi : x) xi = Vec3(u(rng), u(rng), u(rng));
+      integrator.node_space().distribute(x);
+      assembled.apply(x, y_assembled);
+      matrix_free.apply(x, y_matrix_free);
+      double difference = 0.0, norm = 0.0;
+      for (std::size_t i = 0; i < integrator.layout().owned_count; ++i) {
+        difference = std::max(difference, (y_assembled[i] - y_matrix_free[i]).norm());
+        norm = std::max(norm, y_assembled[i].norm());
+      }
+      EXPECT_LT(comm.max(difference), 1e-12 * comm.max(norm)) << (project ? "projected" : "exact");
+    }
+  }
+}
