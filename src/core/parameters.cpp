@@ -23,13 +23,15 @@ std::string ParameterSpec::type_name(Type type) {
     case Type::boolean: return "bool";
     case Type::string: return "string";
     case Type::vector3: return "Array(double)";
+    case Type::real_list: return "Array(double)";
+    case Type::string_list: return "Array(string)";
   }
   return "?";
 }
 
 std::string ParameterSpec::range_text() const {
-  if (type == Type::real || type == Type::integer) {
-    return std::string(min_inclusive ? "[" : "(") + number_text(min) + ", " + number_text(max) +
+  if (type == Type::real || type == Type::integer || type == Type::real_list) {
+    return std::string(type == Type::real_list ? "each in " : "") + std::string(min_inclusive ? "[" : "(") + number_text(min) + ", " + number_text(max) +
            (max_inclusive ? "]" : ")");
   }
   if (type == Type::string && !choices.empty()) {
@@ -52,6 +54,11 @@ std::string ParameterSpec::check(const ParameterValue& value) const {
     for (const auto& c : choices)
       if (c == s) return {};
     return "value '" + s + "' is not " + range_text();
+  } else if (type == Type::real_list) {
+    const auto& list = std::get<RealList>(value);
+    for (double x : list)
+      if (!std::isfinite(x) || !(min_inclusive ? x >= min : x > min) || !(max_inclusive ? x <= max : x < max))
+        return "value " + number_text(x) + " is out of range " + range_text();
   } else if (type == Type::vector3) {
     const auto& v = std::get<Vec3>(value);
     if (!v.allFinite()) return "value has a non-finite component";

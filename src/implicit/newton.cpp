@@ -62,7 +62,8 @@ double velocity_residual(const IncrementalPotential& potential, const NodeVector
 }
 
 NewtonReport newton_solve(const IncrementalPotential& potential, const linalg::NodeSpace& space,
-                          linalg::NewtonSystem& system, const NewtonSettings& settings, NodeVectorField& v) {
+                          linalg::NewtonSystem& system, const NewtonSettings& settings, NodeVectorField& v,
+                          const SystemObserver& observer) {
   static const auto assemble_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3a newton assemble");
   static const auto line_search_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3d newton line search");
   static const auto gradient_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3e newton gradient");
@@ -129,6 +130,7 @@ NewtonReport newton_solve(const IncrementalPotential& potential, const linalg::N
         Teuchos::TimeMonitor timer(*assemble_timer);
         system.assemble(potential, v, projected);
       }
+      if (observer) observer(report.iterations, system, g);
       report.linear_solves.push_back(system.solve(g, dv));
       report.projected_solves += projected;
       potential.constraints().project(dv);

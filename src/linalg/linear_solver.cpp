@@ -111,5 +111,6 @@ SolverConfiguration SolverConfiguration::from_xml(const std::string& xml, const 
 
 const std::string& SolverConfiguration::label() const { return impl_->settings.label; }
 const std::string& SolverConfiguration::origin() const { return impl_->origin; }
+bool SolverConfiguration::matrix_free() const { return impl_->settings.operator_form == "matrix-free"; }
 
 }  // namespace viscompm::linalg

@@ -16,6 +16,15 @@ class MatrixFreeHessian : public HessianOperator {
     const double dt2 = potential.dt() * potential.dt();
     hessians_ = potential.particle_hessians(v, project);
     for (Mat9& h : hessians_) h *= dt2;
+    // Per particle, the weight gradients of its stencil nodes (reused by every product).
+    const grid::GridLayout& layout = potential.layout();
+    const int K = layout.nodes_per_cell();
+    gradients_.resize(hessians_.size() * K);
+    for (std::size_t c = 0; c < layout.cell_count(); ++c)
+      for (std::size_t p = layout.cell_begin[c]; p < layout.cell_begin[c + 1]; ++p)
+        grid::for_each_stencil_node(layout, c, p, [&](int k, int, double, const Vec3& dw) { gradients_[p * K + k] = dw; });
+    free_.resize(layout.local_node_count());
+    for (std::size_t i = 0; i < free_.size(); ++i) free_[i] = potential.constraints().projection[i] == Mat3::Identity();
     const bool changed = space_.version() != space_version_;
     if (changed) {
       space_version_ = space_.version();
@@ -56,6 +65,9 @@ class MatrixFreeHessian : public HessianOperator {
   Teuchos::RCP<Apply> apply_;
   const implicit::IncrementalPotential* potential_ = nullptr;
   std::vector<Mat9> hessians_;  // Δt² ∂²Φ_p/∂A², per particle
+  std::vector<Vec3> gradients_;  // ∇w of each particle's stencil nodes
+  std::vector<char> free_;       // node without constraint
+  mutable NodeVectorField x_nodes_, y_nodes_;
   Teuchos::RCP<vector_type> diagonal_;
   Teuchos::RCP<multivector_type> x_local_, y_local_, y_owned_;
   std::uint64_t space_version_ = 0;
@@ -66,25 +78,33 @@ void MatrixFreeHessian::apply_column(const vector_type& x, vector_type& y, doubl
   const auto& s = space_.impl();
   const grid::GridLayout& layout = potential_->layout();
   const auto& P = potential_->constraints().projection;
+  const int K = layout.nodes_per_cell();
   x_local_->doImport(x, *s.dof_import, Tpetra::INSERT);
   const std::size_t n = layout.local_node_count();
-  NodeVectorField x_nodes(n), y_nodes(n, Vec3::Zero());
+  x_nodes_.resize(n);
+  y_nodes_.assign(n, Vec3::Zero());
   {
     auto view = x_local_->getLocalViewHost(Tpetra::Access::ReadOnly);
-    for (std::size_t i = 0; i < n; ++i) x_nodes[i] = P[i] * Vec3(view(3 * i, 0), view(3 * i + 1, 0), view(3 * i + 2, 0));
-  }
-  for (std::size_t c = 0; c < layout.cell_count(); ++c)
-    for (std::size_t p = layout.cell_begin[c]; p < layout.cell_begin[c + 1]; ++p) {
-      // δA = Σ_j x_j ∇w_jᵀ, then (H δA) ∇w_i back to the nodes.
-      Mat3 dA = Mat3::Zero();
-      grid::for_each_stencil_node(layout, c, p, [&](int, int i, double, const Vec3& dw) { dA += x_nodes[i] * dw.transpose(); });
-      const Mat3 T = unvec(hessians_[p] * vec(dA));
-      grid::for_each_stencil_node(layout, c, p, [&](int, int i, double, const Vec3& dw) { y_nodes[i] += T * dw; });
+    for (std::size_t i = 0; i < n; ++i) {
+      x_nodes_[i] = Vec3(view(3 * i, 0), view(3 * i + 1, 0), view(3 * i + 2, 0));
+      if (!free_[i]) x_nodes_[i] = P[i] * x_nodes_[i];
     }
+  }
+  for (std::size_t c = 0; c < layout.cell_count(); ++c) {
+    const int* nodes = layout.nodes_of_cell(c);
+    for (std::size_t p = layout.cell_begin[c]; p < layout.cell_begin[c + 1]; ++p) {
+      // δA = Σ_j x_j ∇w_jᵀ, T = H_p δA, then y_i += T ∇w_i.
+      const Vec3* dw = gradients_.data() + p * K;
+      Mat3 dA = Mat3::Zero();
+      for (int k = 0; k < K; ++k) dA.noalias() += x_nodes_[nodes[k]] * dw[k].transpose();
+      const Mat3 T = unvec(hessians_[p] * vec(dA));
+      for (int k = 0; k < K; ++k) y_nodes_[nodes[k]].noalias() += T * dw[k];
+    }
+  }
   {
     auto view = y_local_->getLocalViewHost(Tpetra::Access::OverwriteAll);
     for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 yi = P[i] * y_nodes[i];
+      const Vec3 yi = free_[i] ? y_nodes_[i] : Vec3(P[i] * y_nodes_[i]);
       for (int d = 0; d < 3; ++d) view(3 * i + d, 0) = yi[d];
     }
   }

@@ -3,10 +3,12 @@
 #include <MatrixMarket_Tpetra.hpp>
 #include <Teuchos_TimeMonitor.hpp>
 #include <algorithm>
+#include <map>
 #include <chrono>
 
 #include "krylov.hpp"
 #include "hessian_operator.hpp"
+#include "matrix_market_io.hpp"
 
 namespace viscompm::linalg {
 
@@ -133,7 +135,30 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
   const auto matrix = impl_->hessian->matrix();
   if (matrix.is_null()) throw std::logic_error("gather_entries: the operator is matrix-free");
   const auto& A = *matrix;
-  std::vector<double> local;  // (row, column, value) triplets as doubles (exact below 2^53)
+  const auto& s = impl_->space.impl();
+  const MPI_Comm comm = impl_->space.comm().comm();
+  const int ranks = impl_->space.comm().size();
+  // Gathers doubles from every rank to every rank.
+  auto all_gather = [&](const std::vector<double>& local) {
+    int count = static_cast<int>(local.size());
+    std::vector<int> counts(ranks), offsets(ranks, 0);
+    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+    for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<double> all(offsets.back() + counts.back());
+    MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+    return all;
+  };
+  // System node id → grid node id, for every node (ids exact in doubles below 2^53).
+  std::vector<double> pairs;
+  for (std::size_t i = 0; i < s.owned_count; ++i)
+    pairs.insert(pairs.end(), {double(s.local_system_ids[i]), double(s.local_nodes[i])});
+  std::map<long long, long long> grid_of;
+  const auto all_pairs = all_gather(pairs);
+  for (std::size_t k = 0; k < all_pairs.size(); k += 2)
+    grid_of[static_cast<long long>(all_pairs[k])] = static_cast<long long>(all_pairs[k + 1]);
+  auto grid_dof = [&](long long system_dof) { return 3 * grid_of.at(system_dof / 3) + system_dof % 3; };
+
+  std::vector<double> local;  // (row, column, value) triplets
   const auto row_map = A.getRowMap();
   const auto col_map = A.getColMap();
   for (std::size_t r = 0; r < A.getNodeNumRows(); ++r) {
@@ -146,24 +171,34 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
       local.push_back(vals(k));
     }
   }
-  const MPI_Comm comm = impl_->space.comm().comm();
-  int count = static_cast<int>(local.size()), ranks = impl_->space.comm().size();
-  std::vector<int> counts(ranks), offsets(ranks, 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-  std::vector<double> all(offsets.back() + counts.back());
-  MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  const auto all = all_gather(local);
   std::vector<std::tuple<long long, long long, double>> entries;
   for (std::size_t k = 0; k + 2 < all.size(); k += 3)
-    entries.emplace_back(static_cast<long long>(all[k]), static_cast<long long>(all[k + 1]), all[k + 2]);
+    entries.emplace_back(grid_dof(static_cast<long long>(all[k])), grid_dof(static_cast<long long>(all[k + 1])),
+                         all[k + 2]);
   std::sort(entries.begin(), entries.end());
   return entries;
 }
 
-void NewtonSystem::write_matrix_market(const std::string& file) const {
-  const auto matrix = impl_->hessian->matrix();
+void NewtonSystem::write_matrix_market(const std::string& prefix, const NodeVectorField& rhs) const {
+  const Impl& m = *impl_;
+  const auto matrix = m.hessian->matrix();
   if (matrix.is_null()) throw std::logic_error("write_matrix_market: the operator is matrix-free");
-  Tpetra::MatrixMarket::Writer<crs_matrix_type>::writeSparseFile(file, matrix);
+  multivector_type b(m.space.impl().owned_dof_map, 1);
+  m.to_owned(rhs, b);
+  write_contiguous_matrix_market(*matrix, b, prefix);
+}
+
+double NewtonSystem::time_apply(int repetitions) const {
+  const Impl& m = *impl_;
+  multivector_type X(m.space.impl().owned_dof_map, 1), Y(m.space.impl().owned_dof_map, 1);
+  X.randomize();
+  m.hessian->op()->apply(X, Y);  // warm-up
+  m.space.comm().barrier();
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < repetitions; ++k) m.hessian->op()->apply(X, Y);
+  m.space.comm().barrier();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repetitions;
 }
 
 }  // namespace viscompm::linalg

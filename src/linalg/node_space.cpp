@@ -38,13 +38,6 @@ Teuchos::RCP<const map_type> make_map(const std::vector<global_ordinal_type>& gi
   return Teuchos::rcp(new map_type(invalid, Teuchos::ArrayView<const global_ordinal_type>(gids), 0, comm));
 }
 
-std::vector<global_ordinal_type> dof_ids(const std::vector<NodeId>& nodes, std::size_t count) {
-  std::vector<global_ordinal_type> dofs(3 * count);
-  for (std::size_t i = 0; i < count; ++i)
-    for (int d = 0; d < 3; ++d) dofs[3 * i + d] = 3 * nodes[i] + d;
-  return dofs;
-}
-
 // Copies `data` (n rows of `width` values) in and out of a Tpetra multivector through
 // export (ADD into owners) then import (owners to every copy).
 void sum_through(const NodeSpace::Impl& s, double* data, std::size_t rows, bool dofs) {
@@ -87,11 +80,33 @@ bool NodeSpace::update(const std::vector<NodeId>& touched, const parallel::Block
     s.local_nodes = owned;
     s.local_nodes.insert(s.local_nodes.end(), shared.begin(), shared.end());
 
-    const std::vector<global_ordinal_type> local_gids(s.local_nodes.begin(), s.local_nodes.end());
-    s.owned_node_map = make_map(std::vector<global_ordinal_type>(owned.begin(), owned.end()), s.comm);
-    s.local_node_map = make_map(local_gids, s.comm);
-    s.owned_dof_map = make_map(dof_ids(s.local_nodes, s.owned_count), s.comm);
-    s.local_dof_map = make_map(dof_ids(s.local_nodes, s.local_nodes.size()), s.comm);
+    // Contiguous system ids: owned nodes numbered after the ranks before; shared nodes learn
+    // their owner's numbers through an import keyed by grid id.
+    const auto grid_owned = make_map(std::vector<global_ordinal_type>(owned.begin(), owned.end()), s.comm);
+    const auto grid_local = make_map(std::vector<global_ordinal_type>(s.local_nodes.begin(), s.local_nodes.end()), s.comm);
+    long long count = static_cast<long long>(owned.size()), offset = 0;
+    MPI_Exscan(&count, &offset, 1, MPI_LONG_LONG, MPI_SUM, comm_.comm());
+    if (comm_.rank() == 0) offset = 0;
+    Tpetra::Vector<global_ordinal_type, local_ordinal_type, global_ordinal_type, node_type> owned_ids(grid_owned),
+        local_ids(grid_local);
+    {
+      auto v = owned_ids.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      for (std::size_t i = 0; i < owned.size(); ++i) v(i, 0) = offset + static_cast<global_ordinal_type>(i);
+    }
+    local_ids.doImport(owned_ids, import_type(grid_owned, grid_local), Tpetra::INSERT);
+    s.local_system_ids.resize(s.local_nodes.size());
+    {
+      auto v = local_ids.getLocalViewHost(Tpetra::Access::ReadOnly);
+      for (std::size_t i = 0; i < s.local_nodes.size(); ++i) s.local_system_ids[i] = v(i, 0);
+    }
+    const auto global_nodes = static_cast<Tpetra::global_size_t>(comm_.sum(static_cast<std::int64_t>(owned.size())));
+    s.owned_node_map = Teuchos::rcp(new map_type(global_nodes, owned.size(), 0, s.comm));
+    s.local_node_map = make_map(s.local_system_ids, s.comm);
+    s.owned_dof_map = Teuchos::rcp(new map_type(3 * global_nodes, 3 * owned.size(), 0, s.comm));
+    std::vector<global_ordinal_type> local_dofs(3 * s.local_nodes.size());
+    for (std::size_t i = 0; i < s.local_nodes.size(); ++i)
+      for (int d = 0; d < 3; ++d) local_dofs[3 * i + d] = 3 * s.local_system_ids[i] + d;
+    s.local_dof_map = make_map(local_dofs, s.comm);
     s.node_export = Teuchos::rcp(new export_type(s.local_node_map, s.owned_node_map));
     s.dof_export = Teuchos::rcp(new export_type(s.local_dof_map, s.owned_dof_map));
     s.node_import = Teuchos::rcp(new import_type(s.owned_node_map, s.local_node_map));

@@ -84,6 +84,11 @@ class MueLuPreconditioner : public Preconditioner {
     if (!modes.coordinates.is_null()) user.set("Coordinates", modes.coordinates);
     if (!modes.rigid_body_modes.is_null()) user.set("Nullspace", modes.rigid_body_modes);
     if (!params.isParameter("number of equations")) params.set("number of equations", 3);
+    // A hierarchy of one level would hand the whole (distributed) matrix to the coarse direct
+    // solver, which is wrong on more than one rank here (DESIGN.md §5): always coarsen once, so
+    // that the coarse level goes through repartitioning.
+    const auto rows = static_cast<int>(A->getGlobalNumRows());
+    if (rows <= params.get<int>("coarse: max size", 2000)) params.set("coarse: max size", std::max(1, rows / 8));
     prec_ = MueLu::CreateTpetraPreconditioner(Teuchos::rcp_static_cast<operator_type>(A), params);
   }
   Teuchos::RCP<operator_type> op() const override { return prec_; }

@@ -29,6 +29,7 @@ std::string teuchos_type_name(const Teuchos::ParameterEntry& entry) {
   if (any.type() == typeid(std::string)) return "string";
   if (any.type() == typeid(Teuchos::Array<double>)) return "Array(double)";
   if (any.type() == typeid(Teuchos::Array<int>)) return "Array(int)";
+  if (any.type() == typeid(Teuchos::Array<std::string>)) return "Array(string)";
   return any.typeName();
 }
 
@@ -67,6 +68,18 @@ class SpecValidator : public Teuchos::ParameterEntryValidator {
         break;
       case ParameterSpec::Type::string:
         if (any.type() == typeid(std::string)) return Teuchos::any_cast<std::string>(any);
+        break;
+      case ParameterSpec::Type::real_list:
+        if (any.type() == typeid(Teuchos::Array<double>)) {
+          const auto& a = Teuchos::any_cast<Teuchos::Array<double>>(any);
+          return RealList(a.begin(), a.end());
+        }
+        break;
+      case ParameterSpec::Type::string_list:
+        if (any.type() == typeid(Teuchos::Array<std::string>)) {
+          const auto& a = Teuchos::any_cast<Teuchos::Array<std::string>>(any);
+          return StringList(a.begin(), a.end());
+        }
         break;
       case ParameterSpec::Type::vector3:
         if (any.type() == typeid(Teuchos::Array<double>)) {
@@ -184,6 +197,23 @@ ParameterValue parse_value(const ParameterSpec& spec, const std::string& text) {
       if (text == "false" || text == "0") return false;
       break;
     case ParameterSpec::Type::string: return text;
+    case ParameterSpec::Type::real_list:
+    case ParameterSpec::Type::string_list: {
+      std::string cleaned = text;
+      for (char& ch : cleaned)
+        if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
+      std::istringstream v(cleaned);
+      if (spec.type == ParameterSpec::Type::string_list) {
+        StringList list;
+        for (std::string item; v >> item;) list.push_back(item);
+        return list;
+      }
+      RealList list;
+      double x;
+      while (v >> x) list.push_back(x);
+      if ((v >> std::ws).eof() && !list.empty()) return list;
+      break;
+    }
     case ParameterSpec::Type::vector3: {
       std::string cleaned = text;
       for (char& ch : cleaned)
@@ -203,6 +233,8 @@ void set_entry(Teuchos::ParameterList& list, const std::string& name, const Para
         using T = std::decay_t<decltype(v)>;
         if constexpr (std::is_same_v<T, Vec3>) {
           list.set(name, Teuchos::Array<double>(Teuchos::tuple(v[0], v[1], v[2])));
+        } else if constexpr (std::is_same_v<T, RealList> || std::is_same_v<T, StringList>) {
+          list.set(name, Teuchos::Array<typename T::value_type>(v.begin(), v.end()));
         } else {
           list.set(name, v);
         }
@@ -219,6 +251,8 @@ Teuchos::RCP<Teuchos::ParameterList> valid_parameter_list(const std::vector<Para
           using T = std::decay_t<decltype(v)>;
           if constexpr (std::is_same_v<T, Vec3>) {
             valid->set(spec.name, Teuchos::Array<double>(Teuchos::tuple(v[0], v[1], v[2])), spec.doc, validator);
+          } else if constexpr (std::is_same_v<T, RealList> || std::is_same_v<T, StringList>) {
+            valid->set(spec.name, Teuchos::Array<typename T::value_type>(v.begin(), v.end()), spec.doc, validator);
           } else {
             valid->set(spec.name, v, spec.doc, validator);
           }

@@ -215,7 +215,9 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
   static const ParameterTable<OutputSettings> t = [] {
     ParameterTable<OutputSettings> table;
     table.string(&OutputSettings::directory, "Directory", "output", {},
-                 "where frames, particles.xdmf and solver.csv go (--output overrides it)");
+                 "where frames, particles.xdmf and solver.csv go (--output overrides it)")
+        .real_list(&OutputSettings::matrix_market_steps, "Matrix Market steps", {}, Range::at_least(1),
+                   "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx");
     return table;
   }();
   return t;

@@ -109,8 +109,12 @@ void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
     const double remaining = t_end - time_;
     if (dt >= remaining * (1.0 - 1e-9)) dt = remaining;
     else if (dt > 0.5 * remaining) dt = 0.5 * remaining;  // no sliver step before the frame
+    std::string dump_prefix;
+    for (double s : scene_.output.matrix_market_steps)
+      if (static_cast<std::int64_t>(s) == step_ + 1)
+        dump_prefix = scene_.output.directory + "/newton_step_" + std::to_string(step_ + 1);
     for (;;) {
-      const StepReport report = integrator_->step(particles_, time_, dt);
+      const StepReport report = integrator_->step(particles_, time_, dt, dump_prefix);
       const auto& newton = report.newton;
       for (std::size_t k = 0; k < newton.linear_solves.size(); ++k) {
         if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), newton.linear_solves[k]);

@@ -25,7 +25,7 @@ TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::G
   layout_.order = order;
 }
 
-StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, double dt) {
+StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, double dt, const std::string& dump_prefix) {
   static const auto layout_timer = timer("viscompm: 1 layout");
   static const auto p2g_timer = timer("viscompm: 2 p2g");
   static const auto newton_timer = timer("viscompm: 3 newton");
@@ -46,7 +46,12 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
   {
     Teuchos::TimeMonitor m(*newton_timer);
     const int builds = system_.graph_builds();
-    report.newton = implicit::newton_solve(*objective->potential, space_, system_, settings_.newton, v);
+    implicit::SystemObserver dump;
+    if (!dump_prefix.empty())
+      dump = [&](int iteration, const linalg::NewtonSystem& system, const NodeVectorField& rhs) {
+        if (iteration == 1) system.write_matrix_market(dump_prefix, rhs);
+      };
+    report.newton = implicit::newton_solve(*objective->potential, space_, system_, settings_.newton, v, dump);
     report.graph_rebuilt = system_.graph_builds() != builds;
   }
   if (!report.newton.converged) return report;

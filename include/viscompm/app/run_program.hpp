@@ -5,5 +5,6 @@
 namespace viscompm::app {
 
 int run_simulation_program(int argc, char** argv);
+int run_study_program(int argc, char** argv);
 
 }  // namespace viscompm::app

@@ -15,10 +15,12 @@
 
 namespace viscompm {
 
-using ParameterValue = std::variant<double, int, bool, std::string, Vec3>;
+using RealList = std::vector<double>;
+using StringList = std::vector<std::string>;
+using ParameterValue = std::variant<double, int, bool, std::string, Vec3, RealList, StringList>;
 
 struct ParameterSpec {
-  enum class Type { real, integer, boolean, string, vector3 };
+  enum class Type { real, integer, boolean, string, vector3, real_list, string_list };
 
   std::string name;
   Type type = Type::real;
@@ -62,6 +64,8 @@ class ParameterValues {
   bool boolean(const std::string& name) const { return std::get<bool>(at(name)); }
   const std::string& string(const std::string& name) const { return std::get<std::string>(at(name)); }
   const Vec3& vector3(const std::string& name) const { return std::get<Vec3>(at(name)); }
+  const RealList& real_list(const std::string& name) const { return std::get<RealList>(at(name)); }
+  const StringList& string_list(const std::string& name) const { return std::get<StringList>(at(name)); }
 
  private:
   std::map<std::string, ParameterValue> values_;
@@ -90,6 +94,17 @@ class ParameterTable {
   }
   ParameterTable& vector3(Vec3 Struct::*member, std::string name, Vec3 default_value, std::string doc) {
     return bind(member, make(std::move(name), ParameterSpec::Type::vector3, default_value, {}, {}, std::move(doc)));
+  }
+
+  /// A list of numbers; each must lie in `range`.
+  ParameterTable& real_list(RealList Struct::*member, std::string name, RealList default_value, Range range,
+                            std::string doc) {
+    return bind(member, make(std::move(name), ParameterSpec::Type::real_list, std::move(default_value), range, {},
+                             std::move(doc)));
+  }
+  ParameterTable& string_list(StringList Struct::*member, std::string name, StringList default_value, std::string doc) {
+    return bind(member, make(std::move(name), ParameterSpec::Type::string_list, std::move(default_value), {}, {},
+                             std::move(doc)));
   }
 
   const std::vector<ParameterSpec>& specs() const { return specs_; }

@@ -2,6 +2,7 @@
 // CG for the direction, backtracking line search on E that rejects infeasible states.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "viscompm/core/parameters.hpp"
@@ -43,8 +44,12 @@ struct NewtonReport {
 double velocity_residual(const IncrementalPotential& potential, const NodeVectorField& g,
                          const parallel::Communicator& comm);
 
+/// Called after each assembly with the Newton iteration (1-based) and the right-hand side −∇E.
+using SystemObserver = std::function<void(int iteration, const linalg::NewtonSystem& system, const NodeVectorField& rhs)>;
+
 /// Minimises E from the initial guess v (constraints already applied). v holds the result.
 NewtonReport newton_solve(const IncrementalPotential& potential, const linalg::NodeSpace& space,
-                          linalg::NewtonSystem& system, const NewtonSettings& settings, NodeVectorField& v);
+                          linalg::NewtonSystem& system, const NewtonSettings& settings, NodeVectorField& v,
+                          const SystemObserver& observer = {});
 
 }  // namespace viscompm::implicit

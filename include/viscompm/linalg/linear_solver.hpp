@@ -29,6 +29,8 @@ class SolverConfiguration {
   const std::string& label() const;
   /// Where the configuration came from.
   const std::string& origin() const;
+  /// True for the matrix-free Hessian (Operator = matrix-free).
+  bool matrix_free() const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }

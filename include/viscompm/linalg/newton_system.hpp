@@ -42,10 +42,14 @@ class NewtonSystem {
   double assembly_seconds() const;
   /// How many times the graph has been built.
   int graph_builds() const;
-  /// Every entry (global row, global column, value) of H, on every rank, sorted (collective).
+  /// Every entry of H as (row, column, value) with grid dof ids 3·(grid node id) + d, which do not
+  /// depend on the rank count; on every rank, sorted (collective; assembled operators only).
   std::vector<std::tuple<long long, long long, double>> gather_entries() const;
-  /// Writes H to a MatrixMarket file (collective).
-  void write_matrix_market(const std::string& file) const;
+  /// Writes H and a right-hand side (owned entries of `rhs`) to PREFIX.mtx and PREFIX_rhs.mtx,
+  /// renumbered to contiguous indices 1..n (collective; assembled operators only).
+  void write_matrix_market(const std::string& prefix, const NodeVectorField& rhs) const;
+  /// Seconds per application of H (mean of `repetitions`), for benchmarks (collective).
+  double time_apply(int repetitions) const;
   const SolverConfiguration& configuration() const;
 
   struct Impl;

@@ -80,6 +80,7 @@ struct SolverFileSettings {
 
 struct OutputSettings {
   std::string directory = "output";
+  RealList matrix_market_steps;  ///< steps whose first Newton system is written to MatrixMarket
   static const ParameterTable<OutputSettings>& table();
 };
 

@@ -46,8 +46,9 @@ class TimeIntegrator {
                  const linalg::SolverConfiguration& solver);
 
   /// Advances `particles` from time t by dt. If Newton fails, particles are unchanged (only
-  /// reordered) and the report says why.
-  StepReport step(particles::ParticleSet& particles, double t, double dt);
+  /// reordered) and the report says why. A non-empty `dump_prefix` writes the first Newton
+  /// system to PREFIX.mtx / PREFIX_rhs.mtx.
+  StepReport step(particles::ParticleSet& particles, double t, double dt, const std::string& dump_prefix = "");
 
   // The phases of step(), public for tests and the solver study.
   /// Sorts particles by cell and decides node ownership for this step.

@@ -1,0 +1,75 @@
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "viscompm/app/run_program.hpp"
+#include "viscompm/core/error.hpp"
+#include "viscompm/linalg/environment.hpp"
+#include "viscompm/scene/command_line.hpp"
+#include "viscompm/study/solver_study.hpp"
+
+namespace viscompm::app {
+
+namespace {
+std::string describe_study_parameters() {
+  std::string text = "\nStudy parameters (STUDY.xml, addressable by --set):\n";
+  for (const auto& s : study::StudySettings::table().specs())
+    text += "  " + s.name + " (" + ParameterSpec::type_name(s.type) + ", " + s.range_text() + "): " + s.doc + "\n";
+  return text;
+}
+
+// The plot script next to the sources this program was built from.
+std::string plot_script() { return std::string(VISCOMPM_SOURCE_DIR) + "/scripts/plot_study.py"; }
+}  // namespace
+
+int run_study_program(int argc, char** argv) {
+  linalg::Environment environment(&argc, &argv);
+  const parallel::Communicator comm(MPI_COMM_WORLD);
+  const bool root = comm.is_root();
+  try {
+    scene::ProgramOptions options;
+    options.program = "viscompm-study";
+    options.input_name = "STUDY.xml";
+    options.description =
+        "viscompm-study: solve the same Newton systems (of a scene at several resolutions and time steps,\n"
+        "or MatrixMarket files) with several solver configurations. Writes DIR/study.csv, DIR/operators.csv\n"
+        "and DIR/study.png. Exit codes: 0 success, 2 bad input, 3 failure.";
+    options.frames = false;
+    options.restart = false;
+    options.solver = false;
+    options.output_parameter = "Output directory";
+    options.epilogue = describe_study_parameters();
+    const scene::CommandLine cl = scene::parse_command_line(argc, argv, options);
+    if (cl.help) {
+      if (root) std::cout << cl.help_text;
+      return exit_success;
+    }
+    const study::StudySettings settings = study::read_study(cl.input_file, cl.overrides);
+    const int rows = study::run_study(settings, cl.input_file, comm, std::cout);
+    const std::string csv = settings.output_directory + "/study.csv";
+    if (root) {
+      std::cout << "wrote " << rows << " rows to " << csv << "\n";
+      if (settings.plot) {
+        // Debian's matplotlib belongs to the system Python.
+        const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+        const std::string command = python + " " + plot_script() + " " + csv + " " + settings.output_directory +
+                                    "/study.png";
+        if (std::system(command.c_str()) != 0)
+          std::cerr << "viscompm-study: no plot (needs python3 with matplotlib): " << command << "\n";
+      }
+    }
+    return exit_success;
+  } catch (const InputError& e) {
+    if (root) std::cerr << "viscompm-study: " << e.what() << std::endl;
+    return exit_bad_input;
+  } catch (const SimulationError& e) {
+    if (root) std::cerr << "viscompm-study: failed: " << e.what() << std::endl;
+    return exit_simulation_failed;
+  } catch (const std::exception& e) {
+    std::cerr << "viscompm-study: internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
+    MPI_Abort(MPI_COMM_WORLD, exit_simulation_failed);
+    return exit_simulation_failed;
+  }
+}
+
+}  // namespace viscompm::app

@@ -1,0 +1,121 @@
+#include "viscompm/linalg/matrix_market.hpp"
+
+#include <MatrixMarket_Tpetra.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "krylov.hpp"
+#include "matrix_market_io.hpp"
+#include "viscompm/core/error.hpp"
+
+namespace viscompm::linalg {
+
+void write_contiguous_matrix_market(const crs_matrix_type& A, const multivector_type& b, const std::string& prefix) {
+  const auto comm = A.getRowMap()->getComm();
+  const auto rows = A.getRowMap()->getNodeNumElements();
+  const auto contiguous = Teuchos::rcp(new map_type(A.getRowMap()->getGlobalNumElements(), rows, 0, comm));
+  // New ids of the owned rows, then of every column (through the matrix's import).
+  Tpetra::Vector<global_ordinal_type, local_ordinal_type, global_ordinal_type, node_type> owned_ids(A.getRowMap()),
+      column_ids(A.getColMap());
+  {
+    auto v = owned_ids.getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t r = 0; r < rows; ++r) v(r, 0) = contiguous->getGlobalElement(static_cast<local_ordinal_type>(r));
+  }
+  // (The graph has no importer when every column is local.)
+  Teuchos::RCP<const import_type> importer = A.getGraph()->getImporter();
+  if (importer.is_null()) importer = Teuchos::rcp(new import_type(A.getDomainMap(), A.getColMap()));
+  column_ids.doImport(owned_ids, *importer, Tpetra::INSERT);
+  auto renumbered = Teuchos::rcp(new crs_matrix_type(contiguous, A.getGlobalMaxNumRowEntries()));
+  {
+    auto ids = column_ids.getLocalViewHost(Tpetra::Access::ReadOnly);
+    std::vector<global_ordinal_type> columns;
+    for (std::size_t r = 0; r < rows; ++r) {
+      crs_matrix_type::local_inds_host_view_type cols;
+      crs_matrix_type::values_host_view_type vals;
+      A.getLocalRowView(static_cast<local_ordinal_type>(r), cols, vals);
+      columns.resize(cols.extent(0));
+      for (std::size_t k = 0; k < cols.extent(0); ++k) columns[k] = ids(cols(k), 0);
+      renumbered->insertGlobalValues(contiguous->getGlobalElement(static_cast<local_ordinal_type>(r)),
+                                     static_cast<local_ordinal_type>(columns.size()), vals.data(), columns.data());
+    }
+  }
+  renumbered->fillComplete();
+  auto rhs = Teuchos::rcp(new multivector_type(contiguous, 1));
+  {
+    auto out = rhs->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    auto in = b.getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (std::size_t r = 0; r < rows; ++r) out(r, 0) = in(r, 0);
+  }
+  using writer = Tpetra::MatrixMarket::Writer<crs_matrix_type>;
+  writer::writeSparseFile(prefix + ".mtx", renumbered, "viscompm Newton matrix", "H = M + dt^2 Hess(Phi)");
+  writer::writeDenseFile(prefix + "_rhs.mtx", rhs, "viscompm Newton right-hand side", "-grad E");
+}
+
+std::string rhs_file_for(const std::string& matrix_file) {
+  const std::filesystem::path p(matrix_file);
+  return (p.parent_path() / (p.stem().string() + "_rhs" + p.extension().string())).string();
+}
+
+namespace {
+// A fixed matrix behind the HessianOperator interface the preconditioners take.
+class FixedMatrix : public HessianOperator {
+ public:
+  explicit FixedMatrix(Teuchos::RCP<crs_matrix_type> A) : A_(std::move(A)) {}
+  bool update(const implicit::IncrementalPotential&, const NodeVectorField&, bool) override { return false; }
+  Teuchos::RCP<const operator_type> op() const override { return A_; }
+  Teuchos::RCP<crs_matrix_type> matrix() const override { return A_; }
+  Teuchos::RCP<const vector_type> diagonal() const override {
+    auto d = Teuchos::rcp(new vector_type(A_->getRowMap()));
+    A_->getLocalDiagCopy(*d);
+    return d;
+  }
+  std::int64_t nonzeros() const override { return static_cast<std::int64_t>(A_->getGlobalNumEntries()); }
+  int pattern_builds() const override { return 1; }
+
+ private:
+  Teuchos::RCP<crs_matrix_type> A_;
+};
+}  // namespace
+
+MatrixMarketSolve solve_matrix_market(const std::string& matrix_file, const SolverConfiguration& config,
+                                      const parallel::Communicator& comm) {
+  if (config.impl().settings.operator_form == "matrix-free")
+    throw InputError(config.origin() + ": a matrix-free configuration cannot solve a MatrixMarket system");
+  if (!std::ifstream(matrix_file).good()) throw InputError(matrix_file + ": cannot open file");
+  const auto tcomm = Teuchos::rcp(new Teuchos::MpiComm<int>(comm.comm()));
+  using reader = Tpetra::MatrixMarket::Reader<crs_matrix_type>;
+  Teuchos::RCP<crs_matrix_type> A;
+  try {
+    A = reader::readSparseFile(matrix_file, tcomm);
+  } catch (const std::exception& e) {
+    throw InputError(matrix_file + ": not a readable MatrixMarket matrix");
+  }
+  multivector_type b(A->getRangeMap(), 1), x(A->getDomainMap(), 1);
+  const std::string rhs_file = rhs_file_for(matrix_file);
+  if (std::ifstream(rhs_file).good()) {
+    auto map = A->getRangeMap();
+    const auto read = reader::readDenseFile(rhs_file, tcomm, map);
+    b.assign(*read);
+  } else {
+    b.putScalar(1.0);
+  }
+  MatrixMarketSolve result;
+  result.rows = static_cast<std::int64_t>(A->getGlobalNumRows());
+  result.nonzeros = static_cast<std::int64_t>(A->getGlobalNumEntries());
+  FixedMatrix H(A);
+  auto preconditioner = make_preconditioner(config);
+  const auto start = std::chrono::steady_clock::now();
+  preconditioner->setup(H, true, NearNullspace{});
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  KrylovSolver krylov(config);
+  result.report = krylov.solve(A, preconditioner->op(), x, b);
+  result.report.setup_seconds = setup;
+  const auto apply_start = std::chrono::steady_clock::now();
+  for (int k = 0; k < 5; ++k) A->apply(x, b);
+  result.apply_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - apply_start).count() / 5;
+  return result;
+}
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""viscompm-study end to end: study.csv has one row per (problem, resolution, configuration) with
+the contract's columns, failed configurations are rows with converged=0, and a Newton system
+written to MatrixMarket by a run reproduces that run's solve when the study reads it back."""
+import argparse
+import csv
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--viscompm", required=True)
+parser.add_argument("--study", required=True)
+parser.add_argument("--ranks", type=int, default=1)
+parser.add_argument("--mpiexec", required=True)
+parser.add_argument("--inputs", required=True)
+parser.add_argument("--workdir", required=True)
+args = parser.parse_args()
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+        print("FAIL:", message)
+
+
+def run(program, *extra):
+    command = shlex.split(args.mpiexec) + ["-np", str(args.ranks), program, *extra]
+    return subprocess.run(command, capture_output=True, text=True, timeout=900)
+
+
+shutil.rmtree(args.workdir, ignore_errors=True)
+os.makedirs(args.workdir)
+solvers = os.path.join(args.inputs, "solvers")
+configs = ["matrix_free_jacobi_cg.xml", "jacobi_cg.xml", "chebyshev_cg.xml", "muelu_cg.xml"]
+
+# A study of the sponge at two resolutions and two time steps.
+study = os.path.join(args.workdir, "study.xml")
+with open(study, "w") as f:
+    f.write(f"""<ParameterList name="t">
+  <Parameter name="Scene" type="string" value="{args.inputs}/scenes/shooting_sponge.xml"/>
+  <Parameter name="Cell sizes" type="Array(double)" value="{{0.075, 0.06}}"/>
+  <Parameter name="Time steps" type="Array(double)" value="{{2, 20}}"/>
+  <Parameter name="Solvers" type="Array(string)" value="{{{', '.join(os.path.join(solvers, c) for c in configs)}}}"/>
+  <Parameter name="Plot" type="bool" value="false"/>
+</ParameterList>""")
+out = os.path.join(args.workdir, "out")
+result = run(args.study, study, "--output", out)
+check(result.returncode == 0, f"study exits 0: {result.stderr[-1500:]}")
+rows = list(csv.DictReader(open(os.path.join(out, "study.csv")))) if result.returncode == 0 else []
+check(rows and list(rows[0].keys()) == ["problem", "resolution", "dofs", "nonzeros", "ranks", "preconditioner",
+                                        "setup_seconds", "solve_seconds", "iterations", "relative_residual",
+                                        "converged"], "study.csv columns")
+keys = [(r["problem"], r["resolution"], r["preconditioner"]) for r in rows]
+check(len(rows) == 2 * 2 * len(configs), f"{len(rows)} rows for 2 resolutions x 2 time steps x {len(configs)} solvers")
+check(len(set(keys)) == len(keys), "one row per (problem, resolution, preconditioner)")
+check(all(r["converged"] == "1" and float(r["relative_residual"]) < 1e-5 for r in rows), "every solve converged")
+check(all(int(r["ranks"]) == args.ranks for r in rows), "ranks column")
+# The same problem has the same size whatever the configuration.
+sizes = {}
+for r in rows:
+    sizes.setdefault((r["problem"], r["resolution"]), set()).add(r["dofs"])
+check(all(len(s) == 1 for s in sizes.values()), "dofs agree across configurations of a problem")
+# Unpreconditioned CG that cannot converge in its iteration budget is a row, not a crash.
+budget = os.path.join(args.workdir, "tiny_budget.xml")
+with open(budget, "w") as f:
+    f.write("""<ParameterList name="tiny"><Parameter name="Label" type="string" value="starved"/>
+  <Parameter name="Preconditioner" type="string" value="none"/>
+  <ParameterList name="Krylov parameters"><Parameter name="Maximum Iterations" type="int" value="3"/>
+  </ParameterList></ParameterList>""")
+result = run(args.study, study, "--output", out + "_budget", "--set", f"Solvers={{{budget}}}",
+             "--set", "Cell sizes={0.075}", "--set", "Time steps={20}")
+check(result.returncode == 0, "a study with a failing configuration still exits 0")
+rows = list(csv.DictReader(open(os.path.join(out + "_budget", "study.csv")))) if result.returncode == 0 else []
+check(len(rows) == 1 and rows[0]["converged"] == "0", f"the failed solve is a row with converged=0: {rows}")
+
+# MatrixMarket round trip: a run writes step 2's first Newton system; the study reads it back.
+run_dir = os.path.join(args.workdir, "run")
+result = run(args.viscompm, os.path.join(args.inputs, "scenes", "shooting_sponge.xml"), "--output", run_dir,
+             "--frames", "1", "--set", "Grid/Cell size=0.06", "--set", "Output/Matrix Market steps={2}",
+             "--solver", os.path.join(solvers, "jacobi_cg.xml"))
+check(result.returncode == 0, f"run with a MatrixMarket dump exits 0: {result.stderr[-1500:]}")
+logged = [r for r in csv.DictReader(open(os.path.join(run_dir, "solver.csv")))
+          if r["step"] == "2" and r["newton_iteration"] == "1"] if result.returncode == 0 else []
+mm_study = os.path.join(args.workdir, "mm.xml")
+with open(mm_study, "w") as f:
+    f.write(f"""<ParameterList name="mm">
+  <Parameter name="Matrix Market files" type="Array(string)" value="{{{run_dir}/newton_step_2.mtx}}"/>
+  <Parameter name="Solvers" type="Array(string)" value="{{{solvers}/jacobi_cg.xml}}"/>
+  <Parameter name="Plot" type="bool" value="false"/>
+</ParameterList>""")
+result = run(args.study, mm_study, "--output", out + "_mm")
+check(result.returncode == 0, f"MatrixMarket study exits 0: {result.stderr[-1500:]}")
+rows = list(csv.DictReader(open(os.path.join(out + "_mm", "study.csv")))) if result.returncode == 0 else []
+if logged and rows:
+    check(abs(int(rows[0]["iterations"]) - int(logged[0]["linear_iterations"])) <= 1,
+          f"the read-back system takes the run's iterations: {rows[0]['iterations']} vs {logged[0]['linear_iterations']}")
+    check(abs(float(rows[0]["relative_residual"]) - float(logged[0]["relative_residual"]))
+          <= 0.05 * float(logged[0]["relative_residual"]),
+          f"and reaches the run's residual: {rows[0]['relative_residual']} vs {logged[0]['relative_residual']}")
+else:
+    check(False, "MatrixMarket round trip produced rows")
+
+print(f"{len(failures)} failure(s)")
+sys.exit(1 if failures else 0)
