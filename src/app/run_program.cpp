@@ -33,8 +33,7 @@ int run_simulation_program(int argc, char** argv) {
     const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
     const linalg::SolverConfiguration solver =
         linalg::SolverConfiguration::read(cl.solver_file.empty() ? scene.solver_file : cl.solver_file);
-    if (!cl.restart_file.empty()) throw InputError("--restart: checkpoints are not supported by this build");
-    simulation::Simulation simulation(scene, solver, comm);
+    simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);
     Teuchos::TimeMonitor::summarize(std::cout, false, true, false, Teuchos::Union, "viscompm:");
     if (root)

@@ -101,6 +101,21 @@ NodeConstraints Boundary::constrain(const grid::GridLayout& layout, double t,
   return c;
 }
 
+std::size_t Boundary::delete_outside_particles(const grid::GridGeometry& geometry,
+                                              particles::ParticleSet& particles) const {
+  const Vec3 lo = geometry.origin + Vec3::Constant(geometry.dx);
+  const Vec3 hi = geometry.upper_corner() - Vec3::Constant(geometry.dx * (1.0 + 1e-6));
+  std::vector<std::size_t> keep;
+  keep.reserve(particles.size());
+  for (std::size_t p = 0; p < particles.size(); ++p) {
+    const Vec3& x = particles.position[p];
+    if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) keep.push_back(p);
+  }
+  const std::size_t removed = particles.size() - keep.size();
+  if (removed > 0) particles.permute(keep);
+  return removed;
+}
+
 std::size_t Boundary::clamp_particles(const grid::GridGeometry& geometry,
                                       std::vector<Vec3>& positions) const {
   std::size_t moved = 0;

@@ -13,7 +13,7 @@ namespace {
 // lowest rank.
 class PreferBlockOwner : public Tpetra::Details::TieBreak<local_ordinal_type, global_ordinal_type> {
  public:
-  PreferBlockOwner(const parallel::BlockDecomposition& d, const grid::GridGeometry& g)
+  PreferBlockOwner(const parallel::Decomposition& d, const grid::GridGeometry& g)
       : decomposition_(d), geometry_(g) {}
   bool mayHaveSideEffects() const override { return false; }
   std::size_t selectedIndex(global_ordinal_type gid,
@@ -28,7 +28,7 @@ class PreferBlockOwner : public Tpetra::Details::TieBreak<local_ordinal_type, gl
   }
 
  private:
-  const parallel::BlockDecomposition& decomposition_;
+  const parallel::Decomposition& decomposition_;
   const grid::GridGeometry& geometry_;
 };
 
@@ -61,7 +61,7 @@ NodeSpace::NodeSpace(const parallel::Communicator& comm) : comm_(comm), impl_(st
 
 NodeSpace::~NodeSpace() = default;
 
-bool NodeSpace::update(const std::vector<NodeId>& touched, const parallel::BlockDecomposition& decomposition,
+bool NodeSpace::update(const std::vector<NodeId>& touched, const parallel::Decomposition& decomposition,
                        grid::GridLayout& layout) {
   Impl& s = *impl_;
   const bool changed = comm_.any(touched != s.touched) || s.version == 0;

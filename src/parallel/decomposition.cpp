@@ -48,6 +48,11 @@ int BlockDecomposition::owner_of_node(const Int3& ijk) const {
   return a + process_grid_.x() * (b + process_grid_.y() * c);
 }
 
+std::string BlockDecomposition::describe() const {
+  return "blocks " + std::to_string(process_grid_.x()) + "x" + std::to_string(process_grid_.y()) + "x" +
+         std::to_string(process_grid_.z());
+}
+
 void BlockDecomposition::owned_block(int rank, Int3& lower, Int3& upper) const {
   const int a = rank % process_grid_.x();
   const int b = (rank / process_grid_.x()) % process_grid_.y();
@@ -61,6 +66,47 @@ void BlockDecomposition::set_cuts(int d, std::vector<int> cuts) {
       !std::is_sorted(cuts.begin(), cuts.end()))
     throw std::invalid_argument("invalid decomposition cuts");
   cuts_[d] = std::move(cuts);
+}
+
+}  // namespace viscompm::parallel
+
+#include "viscompm/parallel/communicator.hpp"
+
+namespace viscompm::parallel {
+
+BoxDecomposition::BoxDecomposition(const grid::GridGeometry& geometry, std::vector<Box> boxes)
+    : geometry_(geometry), boxes_(std::move(boxes)) {
+  if (boxes_.empty()) throw std::invalid_argument("BoxDecomposition: no boxes");
+}
+
+int BoxDecomposition::owner_of_node(const Int3& ijk) const {
+  const Vec3 x = geometry_.node_position(ijk);
+  // Closed boxes, disjoint by construction: a point is in at most one.
+  auto contains = [&](const Box& b) { return (x.array() >= b.lower.array()).all() && (x.array() <= b.upper.array()).all(); };
+  if (contains(boxes_[last_])) return last_;
+  const int n = static_cast<int>(boxes_.size());
+  for (int r = 0; r < n; ++r)
+    if (contains(boxes_[r])) return last_ = r;
+  // Between or beyond the boxes: the nearest one (the lowest rank on a tie; empty boxes never).
+  int best = 0;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < n; ++r) {
+    if (!(boxes_[r].lower.array() <= boxes_[r].upper.array()).all()) continue;  // empty
+    const double d = (x - x.cwiseMax(boxes_[r].lower).cwiseMin(boxes_[r].upper)).squaredNorm();
+    if (d < best_distance) {
+      best_distance = d;
+      best = r;
+    }
+  }
+  return best;
+}
+
+std::string BoxDecomposition::describe() const { return std::to_string(boxes_.size()) + " RCB boxes"; }
+
+double imbalance(const Communicator& comm, std::size_t local_count) {
+  const double count = static_cast<double>(local_count);
+  const double total = comm.sum(count);
+  return total > 0.0 ? comm.max(count) / (total / comm.size()) : 1.0;
 }
 
 }  // namespace viscompm::parallel

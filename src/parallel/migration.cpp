@@ -4,12 +4,12 @@
 
 namespace viscompm::parallel {
 
-int particle_owner(const BlockDecomposition& decomposition, const grid::GridGeometry& geometry,
+int particle_owner(const Decomposition& decomposition, const grid::GridGeometry& geometry,
                    grid::KernelOrder order, const Vec3& x) {
   return decomposition.owner_of_cell(grid::stencil_base(order, (x - geometry.origin) / geometry.dx));
 }
 
-std::size_t migrate_particles(const Communicator& comm, const BlockDecomposition& decomposition,
+std::size_t migrate_particles(const Communicator& comm, const Decomposition& decomposition,
                               const grid::GridGeometry& geometry, grid::KernelOrder order,
                               particles::ParticleSet& particles) {
   const int ranks = comm.size();

@@ -38,6 +38,11 @@ const ParameterTable<GridSettings>& GridSettings::table() {
         .vector3(&G::upper_corner, "Upper corner", Vec3::Ones(), "upper corner of the domain [m]")
         .real(&G::cell_size, "Cell size", 0.05, Range::positive(), "grid spacing Δx [m]")
         .string(&G::walls, "Walls", "separating", {"sticky", "slip", "separating"}, "contact at the domain faces")
+        .string(&G::outside_particles, "Outside particles", "clamp", {"clamp", "delete"},
+                "particles that reach the last cell of the grid are held there (clamp) or removed and counted (delete)")
+        .real(&G::rebalance_threshold, "Rebalance threshold", 1.25, Range::at_least(0.0),
+              "re-partition the grid (Zoltan2 RCB of the particles) when the largest rank holds more than this "
+              "times the mean particle count; 0 never")
         .integer(&G::wall_thickness, "Wall thickness", 2, Range::closed(1, 8),
                  "nodes closer than this many cells to a face are wall nodes");
     return table;
@@ -216,6 +221,8 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
     ParameterTable<OutputSettings> table;
     table.string(&OutputSettings::directory, "Directory", "output", {},
                  "where frames, particles.xdmf and solver.csv go (--output overrides it)")
+        .integer(&OutputSettings::checkpoint_every, "Checkpoint every", 0, Range::at_least(0),
+                 "write DIR/checkpoint_NNNNN.h5 every this many frames (0: never); --restart continues from one")
         .real_list(&OutputSettings::matrix_market_steps, "Matrix Market steps", {}, Range::at_least(1),
                    "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx");
     return table;

@@ -4,12 +4,16 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 #include <iomanip>
 #include <ostream>
 
 #include "viscompm/core/error.hpp"
+#include "viscompm/io/checkpoint.hpp"
+#include "viscompm/io/particle_file.hpp"
 #include "viscompm/materials/registry.hpp"
 #include "viscompm/parallel/migration.hpp"
+#include "viscompm/parallel/rcb_partition.hpp"
 #include "viscompm/particles/sampling.hpp"
 
 namespace viscompm::simulation {
@@ -48,7 +52,7 @@ boundary::Boundary make_boundary(const scene::SceneConfig& scene) {
 }
 
 particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
-                                        grid::KernelOrder order, const parallel::BlockDecomposition& decomposition,
+                                        grid::KernelOrder order, const parallel::Decomposition& decomposition,
                                         const materials::MaterialList& materials, int rank) {
   particles::ParticleSet set;
   ParticleId id_offset = 0;
@@ -70,16 +74,40 @@ particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const g
 }
 
 Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
-                       const parallel::Communicator& comm)
+                       const parallel::Communicator& comm, const std::string& restart_file)
     : scene_(scene),
       comm_(comm),
       geometry_(make_grid(scene.grid)),
       order_(grid::kernel_order_from_name(scene.simulation.kernel)),
-      decomposition_(geometry_, comm.size()),
+      decomposition_(std::make_unique<parallel::BlockDecomposition>(geometry_, comm.size())),
       materials_(make_materials(scene)),
       boundary_(make_boundary(scene)),
       time_step_cap_(scene.simulation.max_time_step) {
-  particles_ = sample_particles(scene, geometry_, order_, decomposition_, materials_, comm.rank());
+  if (restart_file.empty()) {
+    particles_ = sample_particles(scene, geometry_, order_, *decomposition_, materials_, comm.rank());
+  } else {
+    io::RunState state;
+    std::string names;
+    particles_ = io::read_checkpoint(restart_file, comm_, state, names);
+    if (names != io::material_names(materials_))
+      throw InputError(restart_file + ": its materials (" + names + ") are not the scene's (" +
+                       io::material_names(materials_) + ")");
+    time_ = state.time;
+    step_ = state.step;
+    frame_ = state.frame;
+    time_step_cap_ = state.time_step_cap;
+    restarted_ = true;
+    // The same rank count continues with the same ownership (bit-for-bit restarts).
+    if (state.decomposition_boxes.size() == 6u * static_cast<std::size_t>(comm_.size())) {
+      std::vector<parallel::BoxDecomposition::Box> boxes(comm_.size());
+      for (int r = 0; r < comm_.size(); ++r) {
+        const double* b = state.decomposition_boxes.data() + 6 * r;
+        boxes[r] = {Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5])};
+      }
+      decomposition_ = std::make_unique<parallel::BoxDecomposition>(geometry_, std::move(boxes));
+    }
+    parallel::migrate_particles(comm_, *decomposition_, geometry_, order_, particles_);
+  }
   if (comm_.sum(static_cast<std::int64_t>(particles_.size())) == 0)
     throw InputError(scene.file + ": parameter 'Bodies': no particle falls inside the grid");
   boundary_.clamp_particles(geometry_, particles_.position);
@@ -88,7 +116,8 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
   settings.transfer.scheme = transfer::scheme_from_name(scene.simulation.transfer);
   settings.transfer.flip_ratio = scene.simulation.flip_ratio;
   settings.newton = scene.newton;
-  integrator_ = std::make_unique<TimeIntegrator>(comm_, geometry_, order_, decomposition_, settings, materials_,
+  settings.delete_outside_particles = scene.grid.outside_particles == "delete";
+  integrator_ = std::make_unique<TimeIntegrator>(comm_, geometry_, order_, *decomposition_, settings, materials_,
                                                  boundary_, solver);
 }
 
@@ -102,9 +131,40 @@ double Simulation::suggested_time_step() const {
   return dt;
 }
 
+void Simulation::rebalance_if_needed(RunSummary& summary, std::ostream* log) {
+  const double threshold = scene_.grid.rebalance_threshold;
+  if (threshold <= 0.0 || comm_.size() == 1) return;
+  const double before = parallel::imbalance(comm_, particles_.size());
+  // Re-partition when the threshold is crossed, but not again while the imbalance stays at what
+  // the last re-partition could reach (cells are indivisible).
+  if (before <= std::max(threshold, 1.05 * balanced_imbalance_)) return;
+  auto candidate = parallel::make_rcb_decomposition(comm_, geometry_, particles_);
+  // Keep the new partition only if it balances better (cells are indivisible: on coarse grids
+  // the bisection's cut may land where it cannot help).
+  std::vector<double> counts(comm_.size(), 0.0);
+  for (const Vec3& x : particles_.position) counts[parallel::particle_owner(*candidate, geometry_, order_, x)] += 1.0;
+  MPI_Allreduce(MPI_IN_PLACE, counts.data(), comm_.size(), MPI_DOUBLE, MPI_SUM, comm_.comm());
+  const double total = std::accumulate(counts.begin(), counts.end(), 0.0);
+  const double predicted = *std::max_element(counts.begin(), counts.end()) / (total / comm_.size());
+  if (predicted >= before) {
+    balanced_imbalance_ = before;
+    return;
+  }
+  decomposition_ = std::move(candidate);
+  integrator_->set_decomposition(*decomposition_);
+  parallel::migrate_particles(comm_, *decomposition_, geometry_, order_, particles_);
+  ++summary.rebalances;
+  const double after = parallel::imbalance(comm_, particles_.size());
+  balanced_imbalance_ = after;
+  if (log && comm_.is_root())
+    *log << "  step " << step_ + 1 << ": rebalanced (" << decomposition_->describe() << "), particle imbalance "
+         << before << " -> " << after << "\n";
+}
+
 void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log) {
   const double min_dt = scene_.simulation.min_time_step;
   while (time_ < t_end * (1.0 - 1e-14)) {
+    rebalance_if_needed(summary, log);
     double dt = suggested_time_step();
     const double remaining = t_end - time_;
     if (dt >= remaining * (1.0 - 1e-9)) dt = remaining;
@@ -121,7 +181,10 @@ void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
         summary.linear_iterations += newton.linear_solves[k].iterations;
       }
       summary.newton_iterations += newton.iterations;
-      if (newton.converged) break;
+      if (newton.converged) {
+        summary.particles_deleted += comm_.sum(static_cast<std::int64_t>(report.particles_deleted));
+        break;
+      }
       ++summary.retries;
       if (dt * 0.5 < min_dt)
         throw SimulationError("Newton failed at t = " + std::to_string(time_) + " with the smallest Δt (" +
@@ -150,6 +213,30 @@ std::string clock_text(double seconds) {
 }
 }  // namespace
 
+std::string Simulation::write_checkpoint() const {
+  io::RunState state{time_, step_, frame_, time_step_cap_, scene_.name, {}};
+  if (const auto* boxes = dynamic_cast<const parallel::BoxDecomposition*>(decomposition_.get()))
+    for (const auto& b : boxes->boxes())
+      state.decomposition_boxes.insert(state.decomposition_boxes.end(),
+                                       {b.lower.x(), b.lower.y(), b.lower.z(), b.upper.x(), b.upper.y(), b.upper.z()});
+  return io::write_checkpoint(scene_.output.directory, state, particles_, materials_, comm_);
+}
+
+namespace {
+// The frames a restarted run inherits: their times and sizes, read from the files (rank 0).
+std::vector<io::FrameInfo> existing_frames(const std::string& directory, int last) {
+  std::vector<io::FrameInfo> frames;
+  for (int f = 0; f <= last; ++f) {
+    const std::string path = (std::filesystem::path(directory) / io::frame_file_name(f)).string();
+    if (!std::filesystem::exists(path)) continue;
+    std::int64_t count = 0;
+    io::FileAttributes attributes = io::read_file_attributes(path, count);
+    frames.push_back({f, attributes.reals["time"], attributes.integers["step"], count});
+  }
+  return frames;
+}
+}  // namespace
+
 RunSummary Simulation::run(std::ostream& log) {
   const std::string& directory = scene_.output.directory;
   if (comm_.is_root()) {
@@ -159,30 +246,40 @@ RunSummary Simulation::run(std::ostream& log) {
       throw InputError(scene_.file + ": parameter 'Output/Directory': cannot create '" + directory + "'");
   }
   comm_.barrier();
-  solver_log_ = std::make_unique<io::SolverLog>(directory, comm_.is_root(), comm_.size());
+  solver_log_ = std::make_unique<io::SolverLog>(directory, comm_.is_root(), comm_.size(), restarted_);
 
   RunSummary summary;
   const auto start = std::chrono::steady_clock::now();
+  const int checkpoint_every = scene_.output.checkpoint_every;
   auto write = [&](int frame) {
+    frame_ = frame;
     frames_.push_back(io::write_frame(directory, {frame, time_, step_, 0}, particles_, materials_, comm_));
     if (comm_.is_root()) io::write_xdmf(directory, frames_);
+    if (checkpoint_every > 0 && frame % checkpoint_every == 0) write_checkpoint();
   };
-  write(0);
+  if (restarted_) {
+    if (comm_.is_root()) frames_ = existing_frames(directory, frame_);  // for the XDMF index
+  } else {
+    write(0);
+  }
   const int frames = scene_.simulation.frames;
   const double frame_duration = 1.0 / scene_.simulation.frame_rate;
   const std::int64_t particle_count = comm_.sum(static_cast<std::int64_t>(particles_.size()));
   if (comm_.is_root())
     log << scene_.name << ": " << particle_count << " particles, grid " << geometry_.cells.transpose() << " cells of "
-        << geometry_.dx << " m, " << comm_.size() << " rank(s), " << frames << " frames\n";
-  for (int frame = 1; frame <= frames; ++frame) {
+        << geometry_.dx << " m, " << comm_.size() << " rank(s), " << frames << " frames"
+        << (restarted_ ? ", restarted at frame " + std::to_string(frame_) : std::string()) << "\n";
+  const int first = frame_ + 1;
+  for (int frame = first; frame <= frames; ++frame) {
     advance_to(frame * frame_duration, summary, &log);
     write(frame);
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const int done = frame - first + 1;
     if (comm_.is_root())
       log << "frame " << std::setw(4) << frame << "/" << frames << "  t = " << std::setprecision(4) << std::fixed
           << time_ << " s  steps " << summary.steps << "  newton " << summary.newton_iterations << "  cg "
-          << summary.linear_iterations << "  retries " << summary.retries << "  wall " << clock_text(elapsed) << "  eta "
-          << clock_text(elapsed / frame * (frames - frame)) << std::defaultfloat << std::endl;
+          << summary.linear_iterations << "  retries " << summary.retries << "  wall " << clock_text(elapsed)
+          << "  eta " << clock_text(elapsed / done * (frames - frame)) << std::defaultfloat << std::endl;
   }
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   solver_log_.reset();

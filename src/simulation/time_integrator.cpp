@@ -11,11 +11,11 @@ Teuchos::RCP<Teuchos::Time> timer(const char* name) { return Teuchos::TimeMonito
 }  // namespace
 
 TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::GridGeometry& geometry,
-                               grid::KernelOrder order, const parallel::BlockDecomposition& decomposition,
+                               grid::KernelOrder order, const parallel::Decomposition& decomposition,
                                const IntegratorSettings& settings, const materials::MaterialList& materials,
                                const boundary::Boundary& boundary, const linalg::SolverConfiguration& solver)
     : comm_(comm),
-      decomposition_(decomposition),
+      decomposition_(&decomposition),
       settings_(settings),
       materials_(materials),
       boundary_(boundary),
@@ -89,7 +89,7 @@ std::unique_ptr<StepObjective> TimeIntegrator::build_objective(const particles::
 
 void TimeIntegrator::build_layout(particles::ParticleSet& particles) {
   const std::vector<NodeId> touched = grid::bin_particles(particles, layout_);
-  space_.update(touched, decomposition_, layout_);
+  space_.update(touched, *decomposition_, layout_);
 }
 
 void TimeIntegrator::particles_to_grid(const particles::ParticleSet& particles) {
@@ -108,8 +108,11 @@ void TimeIntegrator::grid_to_particles(particles::ParticleSet& particles, const 
 
 void TimeIntegrator::advect(particles::ParticleSet& particles, double dt, StepReport& report) {
   for (std::size_t p = 0; p < particles.size(); ++p) particles.position[p] += dt * particles.velocity[p];
-  report.particles_clamped = boundary_.clamp_particles(layout_.geometry, particles.position);
-  parallel::migrate_particles(comm_, decomposition_, layout_.geometry, layout_.order, particles);
+  if (settings_.delete_outside_particles)
+    report.particles_deleted = boundary_.delete_outside_particles(layout_.geometry, particles);
+  else
+    report.particles_clamped = boundary_.clamp_particles(layout_.geometry, particles.position);
+  parallel::migrate_particles(comm_, *decomposition_, layout_.geometry, layout_.order, particles);
 }
 
 }  // namespace viscompm::simulation

@@ -61,6 +61,8 @@ class Boundary {
 
   /// Keeps particles where their stencils stay inside the grid; returns how many were moved.
   std::size_t clamp_particles(const grid::GridGeometry& geometry, std::vector<Vec3>& positions) const;
+  /// Removes the particles whose stencils would leave the grid; returns how many.
+  std::size_t delete_outside_particles(const grid::GridGeometry& geometry, particles::ParticleSet& particles) const;
 
   const std::vector<Collider>& colliders() const { return colliders_; }
   const DomainWalls& walls() const { return walls_; }

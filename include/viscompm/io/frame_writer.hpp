@@ -29,6 +29,9 @@ std::string frame_file_name(int frame);
 FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
                       const materials::MaterialList& materials, const parallel::Communicator& comm);
 
+/// The material names in material_id order, comma-separated (an attribute of /particles).
+std::string material_names(const materials::MaterialList& materials);
+
 /// Rewrites DIR/particles.xdmf for `frames` (rank 0 only; temporary name, then rename).
 void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& frames);
 

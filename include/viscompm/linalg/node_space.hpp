@@ -24,7 +24,7 @@ class NodeSpace {
   /// Orders the local nodes of `layout` (owned first, then shared) given the nodes its
   /// particles touch, and indexes its cells. Maps are rebuilt only when some rank's touched
   /// set changed; returns true if they were.
-  bool update(const std::vector<NodeId>& touched, const parallel::BlockDecomposition& decomposition,
+  bool update(const std::vector<NodeId>& touched, const parallel::Decomposition& decomposition,
               grid::GridLayout& layout);
 
   /// Sums the per-rank partial values of every node; afterwards every copy holds the total.

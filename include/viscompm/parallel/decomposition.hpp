@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "viscompm/grid/bspline.hpp"
@@ -11,7 +12,19 @@
 
 namespace viscompm::parallel {
 
-class BlockDecomposition {
+/// Which rank owns each grid node (and so each particle: the owner of its cell).
+class Decomposition {
+ public:
+  virtual ~Decomposition() = default;
+  /// Rank owning node ijk.
+  virtual int owner_of_node(const Int3& ijk) const = 0;
+  /// Rank owning a particle whose stencil starts at `stencil_base`.
+  int owner_of_cell(const Int3& stencil_base) const { return owner_of_node(stencil_base + Int3::Ones()); }
+  /// One line for the log.
+  virtual std::string describe() const = 0;
+};
+
+class BlockDecomposition : public Decomposition {
  public:
   /// Splits the nodes of `geometry` among `ranks` ranks: the process grid is the factorisation of
   /// `ranks` into three factors with the smallest block surface, and cuts are even.
@@ -20,9 +33,8 @@ class BlockDecomposition {
   int ranks() const { return ranks_; }
   const Int3& process_grid() const { return process_grid_; }
   /// Rank owning node ijk (clamped to the grid).
-  int owner_of_node(const Int3& ijk) const;
-  /// Rank owning a particle whose stencil starts at `stencil_base`.
-  int owner_of_cell(const Int3& stencil_base) const { return owner_of_node(stencil_base + Int3::Ones()); }
+  int owner_of_node(const Int3& ijk) const override;
+  std::string describe() const override;
   /// The half-open node range [lower, upper) owned by `rank`.
   void owned_block(int rank, Int3& lower, Int3& upper) const;
   /// Cut positions along dimension d: process slice a owns nodes [cuts[a], cuts[a+1]).
@@ -38,5 +50,33 @@ class BlockDecomposition {
   Int3 process_grid_;
   std::array<std::vector<int>, 3> cuts_;
 };
+
+}  // namespace viscompm::parallel
+
+namespace viscompm::parallel {
+
+/// Ownership by disjoint boxes in space, one per rank (box r belongs to rank r): a node belongs
+/// to the closed box that contains its position, else to the nearest box (lowest rank on a tie;
+/// empty boxes own nothing). Boxes come from a recursive coordinate bisection of
+/// the particles (make_rcb_decomposition, Zoltan2) and are stored in checkpoints.
+class BoxDecomposition : public Decomposition {
+ public:
+  struct Box {
+    Vec3 lower, upper;
+  };
+  BoxDecomposition(const grid::GridGeometry& geometry, std::vector<Box> boxes);
+
+  int owner_of_node(const Int3& ijk) const override;
+  std::string describe() const override;
+  const std::vector<Box>& boxes() const { return boxes_; }
+
+ private:
+  grid::GridGeometry geometry_;
+  std::vector<Box> boxes_;
+  mutable int last_ = 0;  // the box of the previous query (queries come in spatial order); not thread-safe
+};
+
+/// max over ranks of `local_count`, divided by the mean (1 = perfectly balanced).
+double imbalance(const class Communicator& comm, std::size_t local_count);
 
 }  // namespace viscompm::parallel

@@ -10,11 +10,11 @@
 namespace viscompm::parallel {
 
 /// Rank that owns a particle at x.
-int particle_owner(const BlockDecomposition& decomposition, const grid::GridGeometry& geometry,
+int particle_owner(const Decomposition& decomposition, const grid::GridGeometry& geometry,
                    grid::KernelOrder order, const Vec3& x);
 
 /// Moves particles to their owners. Returns the number this rank sent away.
-std::size_t migrate_particles(const Communicator& comm, const BlockDecomposition& decomposition,
+std::size_t migrate_particles(const Communicator& comm, const Decomposition& decomposition,
                               const grid::GridGeometry& geometry, grid::KernelOrder order,
                               particles::ParticleSet& particles);
 

@@ -40,6 +40,8 @@ struct GridSettings {
   double cell_size = 0.05;
   std::string walls = "separating";
   int wall_thickness = 2;
+  std::string outside_particles = "clamp";
+  double rebalance_threshold = 1.25;
   static const ParameterTable<GridSettings>& table();
 };
 
@@ -81,6 +83,7 @@ struct SolverFileSettings {
 struct OutputSettings {
   std::string directory = "output";
   RealList matrix_market_steps;  ///< steps whose first Newton system is written to MatrixMarket
+  int checkpoint_every = 0;      ///< frames between checkpoints (0: none)
   static const ParameterTable<OutputSettings>& table();
 };
 

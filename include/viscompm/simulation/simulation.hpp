@@ -23,7 +23,7 @@ materials::MaterialList make_materials(const scene::SceneConfig& scene);
 boundary::Boundary make_boundary(const scene::SceneConfig& scene);
 /// The particles of all bodies that this rank owns (ids independent of the rank count).
 particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
-                                        grid::KernelOrder order, const parallel::BlockDecomposition& decomposition,
+                                        grid::KernelOrder order, const parallel::Decomposition& decomposition,
                                         const materials::MaterialList& materials, int rank);
 
 struct RunSummary {
@@ -31,19 +31,30 @@ struct RunSummary {
   std::int64_t newton_iterations = 0;
   std::int64_t linear_iterations = 0;
   std::int64_t retries = 0;
+  std::int64_t particles_deleted = 0;
+  int rebalances = 0;
   double wall_seconds = 0.0;
 };
 
 class Simulation {
  public:
+  /// A run of `scene`; with `restart_file`, the state comes from that checkpoint instead of the
+  /// scene's bodies (InputError if it does not fit the scene).
   Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
-             const parallel::Communicator& comm);
+             const parallel::Communicator& comm, const std::string& restart_file = "");
 
-  /// Writes frame 0, then every frame of the scene, logging progress to `log` on rank 0.
+  /// Writes frame 0 (unless restarted), then every remaining frame of the scene, with checkpoints
+  /// as the scene asks, logging progress to `log` on rank 0.
   RunSummary run(std::ostream& log);
+  /// Writes DIR/checkpoint_NNNNN.h5 for the current frame; returns its path.
+  std::string write_checkpoint() const;
   /// Advances to time t_end with adaptive steps (no output). Throws SimulationError if Newton
   /// fails at the smallest Δt.
   void advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr);
+  /// Re-partitions the grid when the particle counts of the ranks drift apart (Grid/Rebalance
+  /// threshold) and migrates the particles (collective).
+  void rebalance_if_needed(RunSummary& summary, std::ostream* log);
+  const parallel::Decomposition& decomposition() const { return *decomposition_; }
   /// The Δt the next step would try (CFL, bounds), before landing on t_end.
   double suggested_time_step() const;
 
@@ -59,7 +70,7 @@ class Simulation {
   parallel::Communicator comm_;
   grid::GridGeometry geometry_;
   grid::KernelOrder order_;
-  parallel::BlockDecomposition decomposition_;
+  std::unique_ptr<parallel::Decomposition> decomposition_;
   materials::MaterialList materials_;
   boundary::Boundary boundary_;
   particles::ParticleSet particles_;
@@ -67,8 +78,11 @@ class Simulation {
   std::unique_ptr<io::SolverLog> solver_log_;  ///< open during run()
   double time_ = 0.0;
   std::int64_t step_ = 0;
+  int frame_ = 0;                 ///< last frame written (or restarted from)
+  bool restarted_ = false;
   double time_step_cap_;          ///< halved when Newton fails, grows ×1.5 per success
   int retries_reported_ = 0;
+  double balanced_imbalance_ = 1.0;  ///< imbalance right after the last re-partition
   std::vector<io::FrameInfo> frames_;
 };
 

@@ -19,6 +19,7 @@ namespace viscompm::simulation {
 
 struct IntegratorSettings {
   Vec3 gravity = Vec3::Zero();
+  bool delete_outside_particles = false;  ///< else clamp them to the last cell
   transfer::TransferSettings transfer;
   implicit::NewtonSettings newton;
 };
@@ -36,12 +37,13 @@ struct StepReport {
   implicit::NewtonReport newton;
   bool graph_rebuilt = false;
   std::size_t particles_clamped = 0;
+  std::size_t particles_deleted = 0;
 };
 
 class TimeIntegrator {
  public:
   TimeIntegrator(const parallel::Communicator& comm, const grid::GridGeometry& geometry, grid::KernelOrder order,
-                 const parallel::BlockDecomposition& decomposition, const IntegratorSettings& settings,
+                 const parallel::Decomposition& decomposition, const IntegratorSettings& settings,
                  const materials::MaterialList& materials, const boundary::Boundary& boundary,
                  const linalg::SolverConfiguration& solver);
 
@@ -63,6 +65,8 @@ class TimeIntegrator {
   void advect(particles::ParticleSet& particles, double dt, StepReport& report);
 
   const IntegratorSettings& settings() const { return settings_; }
+  /// Node ownership from now on (after rebalancing; the particles must be migrated to it).
+  void set_decomposition(const parallel::Decomposition& decomposition) { decomposition_ = &decomposition; }
   const grid::GridLayout& layout() const { return layout_; }
   linalg::NewtonSystem& newton_system() { return system_; }
   linalg::NodeSpace& node_space() { return space_; }
@@ -73,7 +77,7 @@ class TimeIntegrator {
  private:
   parallel::Communicator comm_;
   grid::GridLayout layout_;
-  const parallel::BlockDecomposition& decomposition_;
+  const parallel::Decomposition* decomposition_;
   IntegratorSettings settings_;
   const materials::MaterialList& materials_;
   const boundary::Boundary& boundary_;

@@ -1,0 +1,104 @@
+// Memory bandwidth of the assembled Newton matrix's SpMV against a STREAM-style triad on the
+// same machine and ranks (issue 4's "SpMV at ≥ 70 % of the triad bandwidth"), and one
+// assembly against one matrix-free Hessian-vector product on the same system.
+//
+//   mpiexec -np N build/bin/bench_spmv SCENE.xml CELL_SIZE [DT_IN_CFL]
+//
+// Bytes counted for y = A x (CSR, Tpetra's local kernel): values (8) and column indices (4) per
+// entry, row offsets (8) per row, x read once and y written once (8 + 8 per row): the least
+// traffic any SpMV must move. The triad a = b + s c moves 24 bytes per element (STREAM's count).
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "viscompm/linalg/environment.hpp"
+#include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/linalg/newton_system.hpp"
+#include "viscompm/scene/scene.hpp"
+#include "viscompm/simulation/simulation.hpp"
+
+using namespace viscompm;
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Best-of-10 triad bandwidth of this rank, arrays of `n` doubles (far beyond the caches).
+double triad_bandwidth(std::size_t n) {
+  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
+  const double s = 3.0;
+  double best = 1e300;
+  for (int trial = 0; trial < 10; ++trial) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
+    MPI_Barrier(MPI_COMM_WORLD);
+    best = std::min(best, seconds_since(start));
+  }
+  if (a[n / 2] != 7.0) std::abort();  // keep the loop
+  return 24.0 * static_cast<double>(n) / best;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  linalg::Environment environment(&argc, &argv);
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: bench_spmv SCENE.xml CELL_SIZE [DT_IN_CFL]\n");
+    return 2;
+  }
+  const parallel::Communicator comm(MPI_COMM_WORLD);
+  auto scene = scene::read_scene(argv[1]);
+  scene.grid.cell_size = std::atof(argv[2]);
+  const double dt_cfl = argc > 3 ? std::atof(argv[3]) : 10.0;
+  const auto assembled_config = linalg::SolverConfiguration::read(scene.solver_file);
+  simulation::Simulation sim(scene, assembled_config, comm);
+  auto& integrator = sim.integrator();
+  integrator.build_layout(sim.particles());
+  integrator.particles_to_grid(sim.particles());
+  double wave_speed = 0.0;
+  for (const auto& m : sim.materials()) wave_speed = std::max(wave_speed, m->wave_speed());
+  const auto objective = integrator.build_objective(sim.particles(), 0.0, dt_cfl * sim.grid().dx / wave_speed);
+
+  // Assembled: first assembly (graph build included), second (values only), SpMV.
+  auto& assembled = integrator.newton_system();
+  auto start = std::chrono::steady_clock::now();
+  assembled.assemble(*objective->potential, objective->initial_guess, true);
+  const double first_assembly = comm.max(seconds_since(start));
+  start = std::chrono::steady_clock::now();
+  assembled.assemble(*objective->potential, objective->initial_guess, true);
+  const double assembly = comm.max(seconds_since(start));
+  const double spmv = assembled.time_apply(20);
+  const double rows = static_cast<double>(assembled.global_rows());
+  const double nonzeros = static_cast<double>(assembled.global_nonzeros());
+  const double spmv_bytes = nonzeros * (8.0 + 4.0) + rows * (8.0 + 8.0 + 8.0);
+
+  // Matrix-free: caching the particle Hessians and the diagonal, one Hessian-vector product.
+  const std::string mf_file = std::string(VISCOMPM_SOURCE_DIR) + "/inputs/solvers/matrix_free_jacobi_cg.xml";
+  linalg::NewtonSystem matrix_free(integrator.node_space(), linalg::SolverConfiguration::read(mf_file));
+  start = std::chrono::steady_clock::now();
+  matrix_free.assemble(*objective->potential, objective->initial_guess, true);
+  const double mf_setup = comm.max(seconds_since(start));
+  const double mf_apply = matrix_free.time_apply(20);
+
+  const double triad = comm.sum(triad_bandwidth(std::size_t(40) << 20));  // 3 × 320 MiB per rank
+  const auto particles = comm.sum(static_cast<std::int64_t>(sim.particles().size()));
+  if (comm.is_root()) {
+    std::printf("scene %s, dx %g, dt %g x CFL, %d rank(s): %lld particles, %.0f unknowns, %.0f nonzeros\n", argv[1],
+                scene.grid.cell_size, dt_cfl, comm.size(), static_cast<long long>(particles), rows, nonzeros);
+    std::printf("assembly (graph + values)      %10.4f s\n", first_assembly);
+    std::printf("assembly (values only)         %10.4f s\n", assembly);
+    std::printf("assembled SpMV                 %10.5f s   %.2f GB/s\n", spmv, spmv_bytes / spmv / 1e9);
+    std::printf("matrix-free set-up (H_p, diag) %10.4f s\n", mf_setup);
+    std::printf("matrix-free H·v                %10.5f s\n", mf_apply);
+    std::printf("triad                                        %.2f GB/s\n", triad / 1e9);
+    std::printf("SpMV / triad bandwidth         %10.2f\n", spmv_bytes / spmv / triad);
+    std::printf("assembly (values) / H·v        %10.1f\n", assembly / mf_apply);
+    std::printf("matrix-free H·v / SpMV         %10.2f\n", mf_apply / spmv);
+  }
+  return 0;
+}

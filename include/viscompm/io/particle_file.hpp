@@ -1,0 +1,44 @@
+// One HDF5 file holding every stored per-particle quantity (ParticleSet::for_each_field) under
+// /particles, written collectively by all ranks (parallel HDF5) to a temporary name renamed when
+// complete, and read back by any number of ranks. Frames and checkpoints are such files.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "viscompm/parallel/communicator.hpp"
+#include "viscompm/particles/particle_set.hpp"
+
+namespace viscompm::io {
+
+/// Scalar attributes of the file's root group.
+struct FileAttributes {
+  std::map<std::string, double> reals;
+  std::map<std::string, std::int64_t> integers;
+  std::map<std::string, std::string> strings;
+  std::map<std::string, std::vector<double>> real_arrays;  ///< small 1D root datasets, same on every rank
+};
+
+/// A derived n×3×3 dataset written next to the stored fields (e.g. b^E of (5.5)).
+struct DerivedTensor {
+  std::string name;
+  std::function<Mat3(std::size_t p)> value;
+};
+
+/// Writes `particles` (this rank's rows, in rank order) to `path`; returns the global count.
+std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
+                                 const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
+                                 const std::string& material_names, const parallel::Communicator& comm);
+
+/// The root attributes and particle count of a file, read without its datasets (any rank alone).
+FileAttributes read_file_attributes(const std::string& path, std::int64_t& particle_count);
+
+/// Reads every stored field; rank r gets the r-th of `comm.size()` contiguous slices of rows.
+/// Throws InputError if the file cannot be read or lacks a field.
+particles::ParticleSet read_particle_file(const std::string& path, const parallel::Communicator& comm,
+                                          FileAttributes& attributes);
+
+}  // namespace viscompm::io

@@ -1,0 +1,299 @@
+#include "viscompm/io/particle_file.hpp"
+
+#include <hdf5.h>
+
+#include <filesystem>
+#include <type_traits>
+
+#include "viscompm/core/error.hpp"
+
+namespace viscompm::io {
+
+namespace {
+void check(herr_t status, const std::string& what) {
+  if (status < 0) throw SimulationError("HDF5 error: " + what);
+}
+
+template <class T>
+hid_t memory_type() {
+  if constexpr (std::is_same_v<T, ParticleId>) return H5T_NATIVE_INT64;
+  else if constexpr (std::is_same_v<T, int>) return H5T_NATIVE_INT;
+  else return H5T_NATIVE_DOUBLE;
+}
+
+// Per-row shape and the flattening of a field's element (row-major: tensor [p][i][j] = M_p(i, j)).
+template <class T>
+std::vector<hsize_t> row_shape() {
+  if constexpr (std::is_same_v<T, Vec3>) return {3};
+  else if constexpr (std::is_same_v<T, Mat3>) return {3, 3};
+  else return {};
+}
+
+template <class T>
+auto flatten(const std::vector<T>& field) {
+  if constexpr (std::is_same_v<T, Vec3> || std::is_same_v<T, Mat3>) {
+    constexpr int n = std::is_same_v<T, Vec3> ? 3 : 9;
+    std::vector<double> out(n * field.size());
+    for (std::size_t p = 0; p < field.size(); ++p) {
+      if constexpr (std::is_same_v<T, Vec3>) {
+        for (int d = 0; d < 3; ++d) out[3 * p + d] = field[p][d];
+      } else {
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) out[9 * p + 3 * i + j] = field[p](i, j);
+      }
+    }
+    return out;
+  } else {
+    return field;
+  }
+}
+
+template <class T>
+void unflatten(const std::vector<double>& flat, std::vector<T>& field) {
+  for (std::size_t p = 0; p < field.size(); ++p) {
+    if constexpr (std::is_same_v<T, Vec3>) {
+      for (int d = 0; d < 3; ++d) field[p][d] = flat[3 * p + d];
+    } else {
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) field[p](i, j) = flat[9 * p + 3 * i + j];
+    }
+  }
+}
+
+// Creates dataset `name` of n_total rows and writes this rank's rows at `offset` (collective).
+template <class D>
+void write_rows(hid_t group, const std::string& name, hid_t type, const std::vector<D>& data,
+                const std::vector<hsize_t>& shape, hsize_t n_local, hsize_t offset, hsize_t n_total) {
+  std::vector<hsize_t> dims = {n_total}, start = {offset}, count = {n_local};
+  for (hsize_t d : shape) {
+    dims.push_back(d);
+    start.push_back(0);
+    count.push_back(d);
+  }
+  const int rank = static_cast<int>(dims.size());
+  const hid_t file_space = H5Screate_simple(rank, dims.data(), nullptr);
+  const hid_t dataset = H5Dcreate2(group, name.c_str(), type, file_space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t memory_space = H5Screate_simple(rank, count.data(), nullptr);
+  if (n_local > 0) {
+    check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), name);
+  } else {
+    H5Sselect_none(file_space);
+    H5Sselect_none(memory_space);
+  }
+  const hid_t transfer = H5Pcreate(H5P_DATASET_XFER);
+  H5Pset_dxpl_mpio(transfer, H5FD_MPIO_COLLECTIVE);
+  check(H5Dwrite(dataset, type, memory_space, file_space, transfer, data.data()), name);
+  H5Pclose(transfer);
+  H5Sclose(memory_space);
+  H5Dclose(dataset);
+  H5Sclose(file_space);
+}
+
+// Reads rows [offset, offset + n_local) of dataset `name` (collective).
+template <class D>
+bool read_rows(hid_t group, const std::string& name, hid_t type, std::vector<D>& data,
+               const std::vector<hsize_t>& shape, hsize_t n_local, hsize_t offset) {
+  if (H5Lexists(group, name.c_str(), H5P_DEFAULT) <= 0) return false;
+  const hid_t dataset = H5Dopen2(group, name.c_str(), H5P_DEFAULT);
+  const hid_t file_space = H5Dget_space(dataset);
+  const int rank = H5Sget_simple_extent_ndims(file_space);
+  if (rank != static_cast<int>(shape.size()) + 1) {
+    H5Sclose(file_space);
+    H5Dclose(dataset);
+    return false;
+  }
+  std::vector<hsize_t> start = {offset}, count = {n_local};
+  hsize_t per_row = 1;
+  for (hsize_t d : shape) {
+    start.push_back(0);
+    count.push_back(d);
+    per_row *= d;
+  }
+  data.resize(n_local * per_row);
+  const hid_t memory_space = H5Screate_simple(rank, count.data(), nullptr);
+  if (n_local > 0) {
+    H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  } else {
+    H5Sselect_none(file_space);
+    H5Sselect_none(memory_space);
+  }
+  const hid_t transfer = H5Pcreate(H5P_DATASET_XFER);
+  H5Pset_dxpl_mpio(transfer, H5FD_MPIO_COLLECTIVE);
+  const herr_t status = H5Dread(dataset, type, memory_space, file_space, transfer, data.data());
+  H5Pclose(transfer);
+  H5Sclose(memory_space);
+  H5Sclose(file_space);
+  H5Dclose(dataset);
+  return status >= 0;
+}
+
+void write_string_attribute(hid_t object, const std::string& name, const std::string& value) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, value.size() + 1);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t attribute = H5Acreate2(object, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  check(H5Awrite(attribute, type, value.c_str()), name);
+  H5Aclose(attribute);
+  H5Sclose(space);
+  H5Tclose(type);
+}
+
+template <class T>
+void write_scalar_attribute(hid_t object, const std::string& name, hid_t type, T value) {
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t attribute = H5Acreate2(object, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  check(H5Awrite(attribute, type, &value), name);
+  H5Aclose(attribute);
+  H5Sclose(space);
+}
+
+// Every root attribute, by its HDF5 class.
+herr_t collect_attribute(hid_t location, const char* name, const H5A_info_t*, void* data) {
+  auto& attributes = *static_cast<FileAttributes*>(data);
+  const hid_t attribute = H5Aopen(location, name, H5P_DEFAULT);
+  const hid_t type = H5Aget_type(attribute);
+  const H5T_class_t kind = H5Tget_class(type);
+  if (kind == H5T_FLOAT) {
+    double value = 0.0;
+    H5Aread(attribute, H5T_NATIVE_DOUBLE, &value);
+    attributes.reals[name] = value;
+  } else if (kind == H5T_INTEGER) {
+    std::int64_t value = 0;
+    H5Aread(attribute, H5T_NATIVE_INT64, &value);
+    attributes.integers[name] = value;
+  } else if (kind == H5T_STRING) {
+    std::string value(H5Tget_size(type), '\0');
+    H5Aread(attribute, type, value.data());
+    attributes.strings[name] = value.c_str();
+  }
+  H5Tclose(type);
+  H5Aclose(attribute);
+  return 0;
+}
+}  // namespace
+
+std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
+                                 const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
+                                 const std::string& material_names, const parallel::Communicator& comm) {
+  const std::string temporary = path + ".tmp";
+  const auto n_local = static_cast<long long>(particles.size());
+  long long offset = 0, n_total = 0;
+  MPI_Exscan(&n_local, &offset, 1, MPI_LONG_LONG, MPI_SUM, comm.comm());
+  if (comm.rank() == 0) offset = 0;
+  MPI_Allreduce(&n_local, &n_total, 1, MPI_LONG_LONG, MPI_SUM, comm.comm());
+
+  const hid_t access = H5Pcreate(H5P_FILE_ACCESS);
+  H5Pset_fapl_mpio(access, comm.comm(), MPI_INFO_NULL);
+  const hid_t file = H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access);
+  H5Pclose(access);
+  if (file < 0) throw SimulationError("cannot create " + temporary);
+  for (const auto& [name, value] : attributes.reals) write_scalar_attribute(file, name, H5T_NATIVE_DOUBLE, value);
+  for (const auto& [name, value] : attributes.integers) write_scalar_attribute(file, name, H5T_NATIVE_INT64, value);
+  for (const auto& [name, value] : attributes.strings) write_string_attribute(file, name, value);
+  for (const auto& [name, values] : attributes.real_arrays)
+    write_rows(file, name, H5T_NATIVE_DOUBLE, values, {}, comm.is_root() ? values.size() : 0, 0, values.size());
+  const hid_t group = H5Gcreate2(file, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const auto rows = static_cast<hsize_t>(n_local), start = static_cast<hsize_t>(offset),
+             total = static_cast<hsize_t>(n_total);
+  particles.for_each_field([&](const char* name, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    write_rows(group, name, memory_type<T>(), flatten(field), row_shape<T>(), rows, start, total);
+  });
+  for (const auto& d : derived) {
+    std::vector<Mat3> values(particles.size());
+    for (std::size_t p = 0; p < values.size(); ++p) values[p] = d.value(p);
+    write_rows(group, d.name, H5T_NATIVE_DOUBLE, flatten(values), {3, 3}, rows, start, total);
+  }
+  write_string_attribute(group, "material_names", material_names);
+  H5Gclose(group);
+  check(H5Fclose(file), "close " + temporary);
+  comm.barrier();
+  if (comm.is_root()) std::filesystem::rename(temporary, path);
+  comm.barrier();
+  return n_total;
+}
+
+FileAttributes read_file_attributes(const std::string& path, std::int64_t& particle_count) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) throw InputError(path + ": not a readable HDF5 file");
+  FileAttributes attributes;
+  H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_attribute, &attributes);
+  particle_count = 0;
+  const hid_t dataset = H5Dopen2(file, "particles/id", H5P_DEFAULT);
+  if (dataset >= 0) {
+    hsize_t n = 0;
+    const hid_t space = H5Dget_space(dataset);
+    H5Sget_simple_extent_dims(space, &n, nullptr);
+    particle_count = static_cast<std::int64_t>(n);
+    H5Sclose(space);
+    H5Dclose(dataset);
+  }
+  H5Fclose(file);
+  return attributes;
+}
+
+particles::ParticleSet read_particle_file(const std::string& path, const parallel::Communicator& comm,
+                                          FileAttributes& attributes) {
+  if (!std::filesystem::exists(path)) throw InputError(path + ": cannot open file");
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become our messages
+  const hid_t access = H5Pcreate(H5P_FILE_ACCESS);
+  H5Pset_fapl_mpio(access, comm.comm(), MPI_INFO_NULL);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, access);
+  H5Pclose(access);
+  if (file < 0) throw InputError(path + ": not a readable HDF5 file");
+  H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_attribute, &attributes);
+  // Small root arrays: every rank reads all of each.
+  for (const char* name : {"decomposition_boxes"}) {
+    if (H5Lexists(file, name, H5P_DEFAULT) <= 0) continue;
+    const hid_t dataset = H5Dopen2(file, name, H5P_DEFAULT);
+    const hid_t space = H5Dget_space(dataset);
+    hsize_t n = 0;
+    H5Sget_simple_extent_dims(space, &n, nullptr);
+    H5Sclose(space);
+    H5Dclose(dataset);
+    std::vector<double> values;
+    read_rows(file, name, H5T_NATIVE_DOUBLE, values, {}, n, 0);
+    attributes.real_arrays[name] = values;
+  }
+  const hid_t group = H5Gopen2(file, "particles", H5P_DEFAULT);
+  if (group < 0) {
+    H5Fclose(file);
+    throw InputError(path + ": no /particles group");
+  }
+  H5Aiterate2(group, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_attribute, &attributes);
+  hsize_t n_total = 0;
+  {
+    const hid_t dataset = H5Dopen2(group, "id", H5P_DEFAULT);
+    if (dataset < 0) {
+      H5Gclose(group);
+      H5Fclose(file);
+      throw InputError(path + ": no /particles/id dataset");
+    }
+    const hid_t space = H5Dget_space(dataset);
+    H5Sget_simple_extent_dims(space, &n_total, nullptr);
+    H5Sclose(space);
+    H5Dclose(dataset);
+  }
+  const auto ranks = static_cast<hsize_t>(comm.size()), rank = static_cast<hsize_t>(comm.rank());
+  const hsize_t first = n_total * rank / ranks, last = n_total * (rank + 1) / ranks;
+  particles::ParticleSet particles;
+  particles.resize(last - first);
+  std::string missing;
+  particles.for_each_field([&](const char* name, auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    if constexpr (std::is_same_v<T, Vec3> || std::is_same_v<T, Mat3>) {
+      std::vector<double> flat;
+      if (!read_rows(group, name, H5T_NATIVE_DOUBLE, flat, row_shape<T>(), last - first, first)) missing = name;
+      else unflatten(flat, field);
+    } else {
+      if (!read_rows(group, name, memory_type<T>(), field, {}, last - first, first)) missing = name;
+    }
+  });
+  H5Gclose(group);
+  H5Fclose(file);
+  if (!missing.empty()) throw InputError(path + ": no readable /particles/" + missing + " dataset");
+  return particles;
+}
+
+}  // namespace viscompm::io

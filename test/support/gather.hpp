@@ -1,0 +1,85 @@
+// Particles of a whole communicator, by id, for comparing runs across rank counts.
+#pragma once
+
+#include <mpi.h>
+
+#include <map>
+#include <stdexcept>
+
+#include "viscompm/particles/particle_set.hpp"
+
+namespace viscompm::testkit {
+
+struct ParticleState {
+  Vec3 x, v;
+  Mat3 F, b, C;
+};
+
+// All particles of the communicator, by id, on every rank.
+inline std::map<ParticleId, ParticleState> gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
+  std::vector<double> local;
+  for (std::size_t p = 0; p < ps.size(); ++p) {
+    local.push_back(static_cast<double>(ps.id[p]));
+    for (const Vec3* v : {&ps.position[p], &ps.velocity[p]}) local.insert(local.end(), v->data(), v->data() + 3);
+    for (const Mat3* m : {&ps.deformation_gradient[p], &ps.left_cauchy_green_ob[p], &ps.affine_velocity[p]})
+      local.insert(local.end(), m->data(), m->data() + 9);
+  }
+  int ranks = 1, count = static_cast<int>(local.size());
+  MPI_Comm_size(comm, &ranks);
+  std::vector<int> counts(ranks), offsets(ranks, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(offsets.back() + counts.back());
+  MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  std::map<ParticleId, ParticleState> out;
+  for (std::size_t k = 0; k < all.size(); k += 34) {
+    ParticleState s;
+    s.x = Eigen::Map<const Vec3>(&all[k + 1]);
+    s.v = Eigen::Map<const Vec3>(&all[k + 4]);
+    s.F = Eigen::Map<const Mat3>(&all[k + 7]);
+    s.b = Eigen::Map<const Mat3>(&all[k + 16]);
+    s.C = Eigen::Map<const Mat3>(&all[k + 25]);
+    if (!out.emplace(static_cast<ParticleId>(all[k]), s).second) throw std::runtime_error("duplicate particle id");
+  }
+  return out;
+}
+
+
+// Rank 0 alone, and every rank: the reference and the run under test.
+inline MPI_Comm solo_communicator() {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm solo;
+  MPI_Comm_split(MPI_COMM_WORLD, rank == 0 ? 0 : MPI_UNDEFINED, 0, &solo);
+  return solo;
+}
+
+
+/// Largest difference of positions, velocities, F and b_OB between two gathered runs (throws if
+/// a particle is missing from either).
+inline double max_state_difference(const std::map<ParticleId, ParticleState>& a,
+                                   const std::map<ParticleId, ParticleState>& b) {
+  if (a.size() != b.size()) throw std::runtime_error("the runs hold different particle counts");
+  double worst = 0.0;
+  for (const auto& [id, s] : a) {
+    const auto it = b.find(id);
+    if (it == b.end()) throw std::runtime_error("particle missing from one run");
+    worst = std::max({worst, (it->second.x - s.x).norm(), (it->second.v - s.v).norm(), (it->second.F - s.F).norm(),
+                      (it->second.b - s.b).norm()});
+  }
+  return worst;
+}
+
+/// True if the two gathered runs are equal bit for bit.
+inline bool bitwise_equal(const std::map<ParticleId, ParticleState>& a, const std::map<ParticleId, ParticleState>& b) {
+  if (a.size() != b.size()) return false;
+  for (const auto& [id, s] : a) {
+    const auto it = b.find(id);
+    if (it == b.end() || it->second.x != s.x || it->second.v != s.v || it->second.F != s.F || it->second.b != s.b ||
+        it->second.C != s.C)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace viscompm::testkit
