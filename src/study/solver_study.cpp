@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <random>
 #include <ostream>
 #include <sstream>
 
@@ -25,6 +26,8 @@ const ParameterTable<StudySettings>& StudySettings::table() {
         .string(&S::time_step_unit, "Time step unit", "elastic CFL", {"elastic CFL", "seconds"},
                 "elastic CFL: multiples of Δx/c with c = √((λ+2μ)/ρ) of the stiffest material")
         .real(&S::time, "Time", 0.0, Range::non_negative(), "advance the scene to this time before taking the system [s]")
+        .string(&S::right_hand_side, "Right-hand side", "newton", {"newton", "random"},
+                "newton: the step's −∇E; random: m_i times uniform(−1, 1) per dof, seeded by node (rank-independent)")
         .string_list(&S::solvers, "Solvers", {}, "solver XML files, relative to this file")
         .string_list(&S::matrix_market_files, "Matrix Market files", {}, "extra problems (X.mtx with optional X_rhs.mtx)")
         .integer(&S::repetitions, "Repetitions", 1, Range::closed(1, 100), "solves per pair; the fastest is kept")
@@ -137,14 +140,32 @@ int run_study(const StudySettings& settings, const std::string& study_file, cons
         const bool cfl = settings.time_step_unit == "elastic CFL";
         const double dt = cfl ? step * sim.grid().dx / wave_speed : step;
         const auto objective = integrator.build_objective(sim.particles(), sim.time(), dt);
-        NodeVectorField rhs;
-        if (!objective->potential->gradient(objective->initial_guess, rhs))
-          throw SimulationError("the study's initial guess is infeasible at Δt = " + number(dt));
-        integrator.node_space().accumulate(rhs);
-        for (Vec3& x : rhs) x = -x;
         Row row;
         row.problem = base.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
         row.resolution = h;
+        NodeVectorField rhs;
+        if (comm.any(!objective->potential->gradient(objective->initial_guess, rhs))) {
+          // No Newton system here: every configuration gets a failed row.
+          if (comm.is_root()) log << row.problem << " dx=" << h << ": infeasible initial guess, no system\n";
+          for (const auto& config : configs) {
+            row.report = linalg::LinearSolveReport{};
+            row.report.preconditioner = config.label();
+            writer.row(row);
+          }
+          continue;
+        }
+        integrator.node_space().accumulate(rhs);
+        const auto& layout = integrator.layout();
+        for (std::size_t i = 0; i < rhs.size(); ++i) {
+          if (settings.right_hand_side == "newton") {
+            rhs[i] = -rhs[i];
+          } else {
+            std::mt19937_64 rng(static_cast<std::uint64_t>(layout.nodes[i]));
+            std::uniform_real_distribution<double> u(-1.0, 1.0);
+            rhs[i] = integrator.grid_mass()[i] * Vec3(u(rng), u(rng), u(rng));
+          }
+        }
+        for (std::size_t i = 0; i < rhs.size(); ++i) rhs[i] = objective->constraints.projection[i] * rhs[i];
         std::int64_t nonzeros = -1;
         for (const auto& config : configs) {
           linalg::NewtonSystem system(integrator.node_space(), config);

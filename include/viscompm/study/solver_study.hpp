@@ -20,6 +20,7 @@ struct StudySettings {
   RealList time_steps;                ///< Δt, in `time_step_unit`
   std::string time_step_unit = "elastic CFL";
   double time = 0.0;                  ///< advance the scene to this time first [s]
+  std::string right_hand_side = "newton";  ///< newton: −∇E; random: a fixed random load
   StringList solvers;                 ///< solver XML files, relative to the study file
   StringList matrix_market_files;     ///< extra problems, relative to the study file
   int repetitions = 1;                ///< solves per (problem, configuration); the fastest is kept
