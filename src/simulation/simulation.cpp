@@ -183,6 +183,9 @@ void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
       summary.newton_iterations += newton.iterations;
       if (newton.converged) {
         summary.particles_deleted += comm_.sum(static_cast<std::int64_t>(report.particles_deleted));
+        summary.particles_migrated += comm_.sum(static_cast<std::int64_t>(report.particles_sent));
+        summary.shared_node_steps += comm_.sum(static_cast<std::int64_t>(report.shared_nodes));
+        summary.owned_node_steps += comm_.sum(static_cast<std::int64_t>(report.owned_nodes));
         break;
       }
       ++summary.retries;

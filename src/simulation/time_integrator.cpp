@@ -37,6 +37,8 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
     Teuchos::TimeMonitor m(*layout_timer);
     build_layout(particles);
   }
+  report.owned_nodes = layout_.owned_count;
+  report.shared_nodes = layout_.local_node_count() - layout_.owned_count;
   {
     Teuchos::TimeMonitor m(*p2g_timer);
     particles_to_grid(particles);
@@ -112,7 +114,7 @@ void TimeIntegrator::advect(particles::ParticleSet& particles, double dt, StepRe
     report.particles_deleted = boundary_.delete_outside_particles(layout_.geometry, particles);
   else
     report.particles_clamped = boundary_.clamp_particles(layout_.geometry, particles.position);
-  parallel::migrate_particles(comm_, *decomposition_, layout_.geometry, layout_.order, particles);
+  report.particles_sent = parallel::migrate_particles(comm_, *decomposition_, layout_.geometry, layout_.order, particles);
 }
 
 }  // namespace viscompm::simulation

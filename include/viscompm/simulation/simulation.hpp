@@ -32,6 +32,9 @@ struct RunSummary {
   std::int64_t linear_iterations = 0;
   std::int64_t retries = 0;
   std::int64_t particles_deleted = 0;
+  std::int64_t particles_migrated = 0;  ///< sent between ranks, all steps
+  std::int64_t shared_node_steps = 0;   ///< Σ over steps of the global count of ghost nodes
+  std::int64_t owned_node_steps = 0;    ///< Σ over steps of the global count of nodes
   int rebalances = 0;
   double wall_seconds = 0.0;
 };

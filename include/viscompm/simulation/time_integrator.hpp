@@ -38,6 +38,9 @@ struct StepReport {
   bool graph_rebuilt = false;
   std::size_t particles_clamped = 0;
   std::size_t particles_deleted = 0;
+  std::size_t particles_sent = 0;   ///< migrated to other ranks by this rank
+  std::size_t shared_nodes = 0;     ///< nodes this rank holds but does not own (ghosts)
+  std::size_t owned_nodes = 0;
 };
 
 class TimeIntegrator {

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The measurements of doc/performance.md, one after the other on an otherwise idle machine.
+# Usage: bench/run_benchmarks.sh [OUTPUT_DIR]   (after scripts/demo.sh or scripts/test.sh built)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+OUT="${1:-$ROOT/output/bench}"
+BIN="$ROOT/build/bin"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+mkdir -p "$OUT"
+cmake --build "$ROOT/build" --target bench_spmv viscompm_app viscompm_study_app -j "$(nproc)" >/dev/null
+lscpu > "$OUT/lscpu.txt"
+
+# 1. SpMV bandwidth against a triad; assembly against a matrix-free Hessian-vector product.
+for n in 1 2; do
+  mpiexec -np $n "$BIN/bench_spmv" "$ROOT/inputs/scenes/shooting_sponge.xml" 0.01 100 | tee "$OUT/spmv_np$n.txt"
+done
+
+# 2. Preconditioners at three resolutions and two time steps (the step's Newton system and a random load).
+mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_preconditioners.xml" --output "$OUT/preconditioners" | tee "$OUT/preconditioners.txt"
+mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_preconditioners.xml" --output "$OUT/preconditioners_random" \
+  --set "Right-hand side=random" | tee "$OUT/preconditioners_random.txt"
+
+# 3. §5.7's Jacobi factor during the impact.
+mpiexec -np 2 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_jacobi_factor.xml" --output "$OUT/jacobi_factor" | tee "$OUT/jacobi_factor.txt"
+
+# 4. MueLu reuse across Newton iterations and steps, on 6 frames of the default scene.
+sed 's|<Parameter name="reuse: type" type="string" value="tP"/>|<Parameter name="reuse: type" type="string" value="none"/>|; s|value="muelu-sa"|value="muelu-sa-no-reuse"|' \
+  "$ROOT/inputs/solvers/muelu_cg.xml" > "$OUT/muelu_no_reuse.xml"
+for solver in "$ROOT/inputs/solvers/muelu_cg.xml" "$OUT/muelu_no_reuse.xml"; do
+  name=$(basename "$solver" .xml)
+  mpiexec -np 1 "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --frames 6 --solver "$solver" \
+    --output "$OUT/reuse_$name" | tee "$OUT/reuse_$name.txt"
+done
+
+# 5. Strong scaling of the default scene (the demo) on 1 and 2 ranks.
+for n in 1 2; do
+  /usr/bin/time -v mpiexec -np $n "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --output "$OUT/demo_np$n" \
+    > "$OUT/demo_np$n.txt" 2> "$OUT/demo_np$n.time"
+done
+echo "benchmarks in $OUT"
