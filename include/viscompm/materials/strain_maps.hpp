@@ -23,7 +23,10 @@ struct FlowStrainMap {
   Mat3 predict(const Mat3& A) const {
     const Mat3 B = A * K1;
     Mat3 S = K0 + B + B.transpose();
-    if (quadratic) S += A * K2 * A.transpose();
+    if (quadratic) {
+      const Mat3 C = A * K2 * A.transpose();
+      S += 0.5 * (C + C.transpose());  // symmetric to the last bit, so b stays exactly symmetric
+    }
     return S;
   }
   /// P(A) = K1 + K2 A^T: dŜ = dA P + P^T dA^T.
