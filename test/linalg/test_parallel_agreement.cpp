@@ -1,9 +1,12 @@
 // One rank and N ranks agree: the same assembled Newton matrix (global ids, values to rounding)
-// and the same particles after full steps (to solver tolerance). The reference runs on a
+// and the same particles — every stored field — after full steps (to solver tolerance), for the
+// sponge scene and for a scene with every constitutive model. The reference runs on a
 // communicator holding rank 0 alone, inside the same test.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <map>
+#include <type_traits>
 
 #include "scenes.hpp"
 #include "viscompm/simulation/simulation.hpp"
@@ -11,20 +14,13 @@
 using namespace viscompm;
 
 namespace {
-struct ParticleState {
-  Vec3 x, v;
-  Mat3 F, b, C;
-};
+// Every stored field of a particle, packed (particles::pack_particle), by id.
+using ParticleStates = std::map<ParticleId, std::vector<double>>;
 
 // All particles of the communicator, by id, on every rank.
-std::map<ParticleId, ParticleState> gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
+ParticleStates gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
   std::vector<double> local;
-  for (std::size_t p = 0; p < ps.size(); ++p) {
-    local.push_back(static_cast<double>(ps.id[p]));
-    for (const Vec3* v : {&ps.position[p], &ps.velocity[p]}) local.insert(local.end(), v->data(), v->data() + 3);
-    for (const Mat3* m : {&ps.deformation_gradient[p], &ps.left_cauchy_green_ob[p], &ps.affine_velocity[p]})
-      local.insert(local.end(), m->data(), m->data() + 9);
-  }
+  for (std::size_t p = 0; p < ps.size(); ++p) particles::pack_particle(ps, p, local);
   int ranks = 1, count = static_cast<int>(local.size());
   MPI_Comm_size(comm, &ranks);
   std::vector<int> counts(ranks), offsets(ranks, 0);
@@ -32,18 +28,48 @@ std::map<ParticleId, ParticleState> gather_particles(const particles::ParticleSe
   for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
   std::vector<double> all(offsets.back() + counts.back());
   MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
-  std::map<ParticleId, ParticleState> out;
-  for (std::size_t k = 0; k < all.size(); k += 34) {
-    ParticleState s;
-    s.x = Eigen::Map<const Vec3>(&all[k + 1]);
-    s.v = Eigen::Map<const Vec3>(&all[k + 4]);
-    s.F = Eigen::Map<const Mat3>(&all[k + 7]);
-    s.b = Eigen::Map<const Mat3>(&all[k + 16]);
-    s.C = Eigen::Map<const Mat3>(&all[k + 25]);
-    EXPECT_TRUE(out.emplace(static_cast<ParticleId>(all[k]), s).second) << "duplicate id " << all[k];
+  ParticleStates out;
+  particles::ParticleSet unpacked;
+  particles::unpack_particles(all, unpacked);
+  const std::size_t stride = particles::packed_doubles_per_particle();
+  for (std::size_t p = 0; p < unpacked.size(); ++p) {
+    std::vector<double> state(all.begin() + p * stride, all.begin() + (p + 1) * stride);
+    EXPECT_TRUE(out.emplace(unpacked.id[p], std::move(state)).second) << "duplicate id " << unpacked.id[p];
   }
   return out;
 }
+
+// Offsets and lengths of each field in a packed particle.
+std::map<std::string, std::pair<std::size_t, std::size_t>> packed_layout() {
+  std::map<std::string, std::pair<std::size_t, std::size_t>> layout;
+  std::size_t offset = 0;
+  particles::ParticleSet().for_each_field([&](const char* name, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    const std::size_t n = std::is_same_v<T, Mat3> ? 9 : std::is_same_v<T, Vec3> ? 3 : 1;
+    layout[name] = {offset, n};
+    offset += n;
+  });
+  return layout;
+}
+
+// The largest difference of one field over all particles.
+double worst_difference(const ParticleStates& a, const ParticleStates& b, const std::string& field) {
+  const auto [offset, length] = packed_layout().at(field);
+  double worst = 0.0;
+  for (const auto& [id, state] : b) {
+    const auto it = a.find(id);
+    if (it == a.end()) return std::numeric_limits<double>::infinity();
+    for (std::size_t k = offset; k < offset + length; ++k) worst = std::max(worst, std::abs(it->second[k] - state[k]));
+  }
+  return worst;
+}
+
+// The scenes compared: the sponge (two Oldroyd-B materials, grips, a bullet) and every model at once.
+scene::SceneConfig scene_named(const std::string& name) {
+  return name == "sponge" ? testkit::sponge_scene() : testkit::mixed_models_scene();
+}
+
+class ParallelAgreement : public ::testing::TestWithParam<std::string> {};
 
 // Rank 0 alone, and every rank: the reference and the run under test.
 MPI_Comm solo_communicator() {
@@ -56,8 +82,9 @@ MPI_Comm solo_communicator() {
 
 using Entries = std::vector<std::tuple<long long, long long, double>>;
 
-Entries first_newton_matrix(const parallel::Communicator& comm, std::int64_t& particle_count) {
-  simulation::Simulation sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-12), comm);
+Entries first_newton_matrix(const std::string& scene, const parallel::Communicator& comm,
+                            std::int64_t& particle_count) {
+  simulation::Simulation sim(scene_named(scene), testkit::jacobi_cg(1e-12), comm);
   auto& integrator = sim.integrator();
   integrator.build_layout(sim.particles());
   integrator.particles_to_grid(sim.particles());
@@ -68,13 +95,13 @@ Entries first_newton_matrix(const parallel::Communicator& comm, std::int64_t& pa
 }
 }  // namespace
 
-TEST(ParallelAgreement, AssembledMatrixIsTheSameOnOneRankAndOnAll) {
+TEST_P(ParallelAgreement, AssembledMatrixIsTheSameOnOneRankAndOnAll) {
   const parallel::Communicator world(MPI_COMM_WORLD);
   std::int64_t n_world = 0, n_solo = 0;
-  const Entries all = first_newton_matrix(world, n_world);
+  const Entries all = first_newton_matrix(GetParam(), world, n_world);
   Entries reference;
   if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
-    reference = first_newton_matrix(parallel::Communicator(solo), n_solo);
+    reference = first_newton_matrix(GetParam(), parallel::Communicator(solo), n_solo);
     MPI_Comm_free(&solo);
   }
   if (!world.is_root()) return;
@@ -91,16 +118,16 @@ TEST(ParallelAgreement, AssembledMatrixIsTheSameOnOneRankAndOnAll) {
   EXPECT_GT(all.size(), 10000u);
 }
 
-TEST(ParallelAgreement, FullStepsAreTheSameOnOneRankAndOnAll) {
+TEST_P(ParallelAgreement, FullStepsAreTheSameOnOneRankAndOnAll) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const double t_end = 0.02;  // several steps: migration, graph rebuilds, bullet contact
-  simulation::Simulation sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-12), world);
+  const double t_end = 0.02;  // several steps: migration, graph rebuilds, contact, plastic flow
+  simulation::Simulation sim(scene_named(GetParam()), testkit::jacobi_cg(1e-12), world);
   simulation::RunSummary summary;
   sim.advance_to(t_end, summary);
   const auto all = gather_particles(sim.particles(), world.comm());
-  std::map<ParticleId, ParticleState> reference;
+  ParticleStates reference;
   if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
-    simulation::Simulation solo_sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-12), parallel::Communicator(solo));
+    simulation::Simulation solo_sim(scene_named(GetParam()), testkit::jacobi_cg(1e-12), parallel::Communicator(solo));
     simulation::RunSummary solo_summary;
     solo_sim.advance_to(t_end, solo_summary);
     EXPECT_EQ(solo_summary.steps, summary.steps);
@@ -109,19 +136,38 @@ TEST(ParallelAgreement, FullStepsAreTheSameOnOneRankAndOnAll) {
   }
   if (!world.is_root()) return;
   ASSERT_EQ(all.size(), reference.size());
-  double dx = 0.0, dv = 0.0, dF = 0.0, db = 0.0, speed = 0.0;
-  for (const auto& [id, s] : reference) {
-    const auto it = all.find(id);
-    ASSERT_NE(it, all.end()) << "particle " << id << " missing";
-    dx = std::max(dx, (it->second.x - s.x).norm());
-    dv = std::max(dv, (it->second.v - s.v).norm());
-    dF = std::max(dF, (it->second.F - s.F).norm());
-    db = std::max(db, (it->second.b - s.b).norm());
-    speed = std::max(speed, s.v.norm());
-  }
+  double speed = 0.0;
+  const auto [v_offset, v_length] = packed_layout().at("velocity");
+  for (const auto& [id, state] : reference) speed = std::max(speed, Eigen::Map<const Vec3>(&state[v_offset]).norm());
   EXPECT_GT(speed, 0.1);
-  EXPECT_LT(dx, 1e-9);
-  EXPECT_LT(dv, 1e-7 * speed);
-  EXPECT_LT(dF, 1e-8);
-  EXPECT_LT(db, 1e-8);
+  EXPECT_LT(worst_difference(all, reference, "position"), 1e-9);
+  EXPECT_LT(worst_difference(all, reference, "velocity"), 1e-7 * speed);
+  // Every stored strain and plastic variable, whatever the model.
+  for (const char* field : {"deformation_gradient", "left_cauchy_green_ob", "elastic_deformation_gradient",
+                            "plastic_deformation_gradient", "equivalent_plastic_strain"})
+    EXPECT_LT(worst_difference(all, reference, field), 1e-8) << field;
+  EXPECT_EQ(worst_difference(all, reference, "material_id"), 0.0);
 }
+
+TEST(ParallelAgreement, TheMixedSceneExercisesEveryModelsPlasticity) {
+  // The mixed scene is only a test of every model if each of them deforms, and the plastic ones flow.
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  simulation::Simulation sim(testkit::mixed_models_scene(), testkit::jacobi_cg(1e-12), world);
+  simulation::RunSummary summary;
+  sim.advance_to(0.02, summary);
+  const auto& ps = sim.particles();
+  const auto& materials = sim.materials();
+  std::vector<double> strain(materials.size(), 0.0), flowed(materials.size(), 0.0);
+  for (std::size_t p = 0; p < ps.size(); ++p) {
+    const int m = ps.material_id[p];
+    strain[m] = std::max(strain[m], (ps.deformation_gradient[p] - Mat3::Identity()).norm());
+    flowed[m] = std::max(flowed[m], ps.yield_function[p] > 0.0 ? 1.0 : 0.0);
+  }
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    EXPECT_GT(world.max(strain[m]), 1e-3) << materials[m]->name();
+    if (materials[m]->model() != "oldroyd_b" && materials[m]->model() != "neo_hookean")
+      EXPECT_EQ(world.max(flowed[m]), 1.0) << materials[m]->name() << " never flowed plastically";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, ParallelAgreement, ::testing::Values("sponge", "mixed_models"));
