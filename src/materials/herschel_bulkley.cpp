@@ -45,30 +45,20 @@ namespace herschel_bulkley {
 
 Mat3 unimodular(const Mat3& b) { return b / std::cbrt(b.determinant()); }
 
-namespace {
-// ‖dev b̂‖ and tr b̂.
-std::pair<double, double> deviatoric_norm_and_trace(const Mat3& b_hb) {
+FlowRule flow_rule(const HerschelBulkleyParameters& parameters, const Mat3& b_hb) {
   const Mat3 b_hat = unimodular(b_hb);
-  const double trace = b_hat.trace();
-  return {(b_hat - trace / 3.0 * Mat3::Identity()).norm(), trace};
-}
-}  // namespace
-
-double yield_function(const HerschelBulkleyParameters& parameters, const Mat3& b_hb) {
-  return deviatoric_norm_and_trace(b_hb).first - parameters.yield_stress;
-}
-
-double plastic_rate(const HerschelBulkleyParameters& parameters, const Mat3& b_hb) {
-  const double excess = yield_function(parameters, b_hb);
-  if (!(excess > 0.0)) return 0.0;
-  return std::pow(excess / parameters.plastic_viscosity, 1.0 / parameters.flow_index);  // §4.2.5
+  FlowRule r;
+  r.trace = b_hat.trace();
+  r.deviatoric_norm = (b_hat - r.trace / 3.0 * Mat3::Identity()).norm();
+  r.yield_function = r.deviatoric_norm - parameters.yield_stress;
+  if (r.yield_function > 0.0)  // max(0, (‖dev b̂‖ − σ_Y)/η)^{1/h} (§4.2.5)
+    r.plastic_rate = std::pow(r.yield_function / parameters.plastic_viscosity, 1.0 / parameters.flow_index);
+  return r;
 }
 
-double plastic_coefficient(const HerschelBulkleyParameters& parameters, const Mat3& b_hb, double dt) {
-  const auto [deviatoric_norm, trace] = deviatoric_norm_and_trace(b_hb);
-  const double rate = plastic_rate(parameters, b_hb);
-  if (rate == 0.0) return 0.0;
-  return 2.0 * dt / 3.0 * trace * rate / deviatoric_norm;  // a of §4.6.2
+double FlowRule::plastic_coefficient(double dt) const {
+  if (plastic_rate == 0.0) return 0.0;
+  return 2.0 * dt / 3.0 * trace * plastic_rate / deviatoric_norm;  // a of §4.6.2, on b̂
 }
 
 }  // namespace herschel_bulkley
@@ -86,7 +76,7 @@ double HerschelBulkley::wave_speed() const {
 FlowStrainMap HerschelBulkley::flow_strain_map(const particles::ParticleSet& particles, std::size_t p,
                                                double dt) const {
   const Mat3& b_hb = particles.left_cauchy_green_ob[p];
-  return flow_strain_map_herschel_bulkley(b_hb, herschel_bulkley::plastic_coefficient(parameters_, b_hb, dt));
+  return flow_strain_map_herschel_bulkley(b_hb, herschel_bulkley::flow_rule(parameters_, b_hb).plastic_coefficient(dt));
 }
 
 bool HerschelBulkley::evaluate(const particles::ParticleSet& particles, std::size_t p, const Mat3& A,
@@ -104,11 +94,12 @@ void HerschelBulkley::update_state(particles::ParticleSet& particles, std::size_
                                    const StepContext& step) const {
   Mat3& F = particles.deformation_gradient[p];
   Mat3& b_hb = particles.left_cauchy_green_ob[p];
-  particles.yield_function[p] = herschel_bulkley::yield_function(parameters_, b_hb);
-  particles.equivalent_plastic_strain[p] +=
-      std::sqrt(2.0 / 3.0) * step.dt * herschel_bulkley::plastic_rate(parameters_, b_hb);
-  b_hb = herschel_bulkley::unimodular(flow_strain_map(particles, p, step.dt).predict(A));  // §4.6.2
-  F = (Mat3::Identity() + A) * F;                                                          // (5.12)
+  const herschel_bulkley::FlowRule rule = herschel_bulkley::flow_rule(parameters_, b_hb);
+  particles.yield_function[p] = rule.yield_function;
+  particles.equivalent_plastic_strain[p] += std::sqrt(2.0 / 3.0) * step.dt * rule.plastic_rate;
+  const FlowStrainMap map = flow_strain_map_herschel_bulkley(b_hb, rule.plastic_coefficient(step.dt));
+  b_hb = herschel_bulkley::unimodular(map.predict(A));  // §4.6.2, then det b_HB = 1
+  F = (Mat3::Identity() + A) * F;                        // (5.12)
 }
 
 Mat3 HerschelBulkley::left_cauchy_green_elastic(const particles::ParticleSet& particles, std::size_t p) const {

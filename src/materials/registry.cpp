@@ -1,5 +1,7 @@
 #include "viscompm/materials/registry.hpp"
 
+#include <type_traits>
+
 #include "viscompm/materials/herschel_bulkley.hpp"
 #include "viscompm/materials/neo_hookean.hpp"
 #include "viscompm/materials/oldroyd_b.hpp"
@@ -22,7 +24,8 @@ ModelEntry entry(std::string model, std::string summary,
   e.summary = std::move(summary);
   e.parameters = table().specs();
   e.create = [table, model = e.model](const std::string& name, const ParameterValues& values) -> std::unique_ptr<Material> {
-    if constexpr (std::is_same_v<Model, HerschelBulkley>)
+    // A model class serving several registry names (herschel_bulkley, bingham) is told which.
+    if constexpr (std::is_constructible_v<Model, std::string, Parameters, std::string>)
       return std::make_unique<Model>(name, table().parse(values), model);
     else
       return std::make_unique<Model>(name, table().parse(values));

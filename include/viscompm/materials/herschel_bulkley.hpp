@@ -30,12 +30,17 @@ namespace herschel_bulkley {
 
 /// The unimodular part b / det(b)^{1/3} of an SPD matrix.
 Mat3 unimodular(const Mat3& b);
-/// ‖dev b̂‖ − σ_Y: the flow rule's yield function (> 0: plastic flow).
-double yield_function(const HerschelBulkleyParameters& parameters, const Mat3& b_hb);
-/// The plastic rate max(0, (‖dev b̂‖ − σ_Y)/η)^{1/h} of §4.2.5 [1/s].
-double plastic_rate(const HerschelBulkleyParameters& parameters, const Mat3& b_hb);
-/// The coefficient a of the update above for a step of size dt.
-double plastic_coefficient(const HerschelBulkleyParameters& parameters, const Mat3& b_hb, double dt);
+
+/// The flow rule at a strain b_HB, evaluated on b̂ = unimodular(b_HB).
+struct FlowRule {
+  double trace = 3.0;            ///< tr b̂
+  double deviatoric_norm = 0.0;  ///< ‖dev b̂‖
+  double yield_function = 0.0;   ///< ‖dev b̂‖ − σ_Y (> 0: plastic flow)
+  double plastic_rate = 0.0;     ///< max(0, (‖dev b̂‖ − σ_Y)/η)^{1/h} of §4.2.5 [1/s]
+  /// The coefficient a of the update above for a step of size dt.
+  double plastic_coefficient(double dt) const;
+};
+FlowRule flow_rule(const HerschelBulkleyParameters& parameters, const Mat3& b_hb);
 
 }  // namespace herschel_bulkley
 
