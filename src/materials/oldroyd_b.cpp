@@ -107,11 +107,6 @@ Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const 
   return m;
 }
 
-Mat3 predicted_b_ob(const Mat3& S, const Mat3& A, double dt, double weissenberg) {
-  const Mat3 B = A * S;
-  return S + dt / weissenberg * (Mat3::Identity() - S) + B + B.transpose();
-}
-
 Mat3 elastic_left_cauchy_green(const Mat3& F, const Mat3& b_ob) {
   const double J = F.determinant();
   return std::cbrt(J * J / b_ob.determinant()) * b_ob;

@@ -11,8 +11,8 @@
 #include <Eigen/Core>
 
 #include "viscompm/core/parameters.hpp"
-#include "viscompm/materials/shared_parameters.hpp"
 #include "viscompm/materials/material.hpp"
+#include "viscompm/materials/shared_parameters.hpp"
 #include "viscompm/materials/strain_maps.hpp"
 
 namespace viscompm::materials {
@@ -63,8 +63,6 @@ EnergyHessian energy_hessian_blocks(const Coefficients& c, const Mat3& F, const 
 Vec27 energy_gradient(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 
-/// Ŝ(A) of (5.14): S + A S + S A^T + (Δt/Wi)(I − S).
-Mat3 predicted_b_ob(const Mat3& S, const Mat3& A, double dt, double weissenberg);
 /// b^E = (J / J_OB)^{2/3} b_OB of (5.5).
 Mat3 elastic_left_cauchy_green(const Mat3& F, const Mat3& b_ob);
 
