@@ -8,8 +8,8 @@
 namespace viscompm::materials {
 
 namespace {
-template <class Table>
-void add_flow_rule_parameters(Table& table) {
+// The parameters herschel_bulkley and bingham share, declared once.
+void add_flow_rule_parameters(ParameterTable<HerschelBulkleyParameters>& table) {
   using P = HerschelBulkleyParameters;
   add_elastic_parameters(table, "(5.8)");
   add_newtonian_parameters(table);
