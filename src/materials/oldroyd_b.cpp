@@ -1,33 +1,31 @@
 #include "viscompm/materials/oldroyd_b.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 #include "viscompm/core/error.hpp"
 
 namespace viscompm::materials {
 
-ViscosityConvention viscosity_convention_from_name(const std::string& name) {
-  if (name == "paper") return ViscosityConvention::paper;
-  if (name == "physical") return ViscosityConvention::physical;
-  throw InputError("unknown viscosity convention '" + name + "' (expected paper or physical)");
+OldroydBUpdate oldroyd_b_update_from_name(const std::string& name) {
+  if (name == "paper") return OldroydBUpdate::paper;
+  if (name == "spd") return OldroydBUpdate::spd;
+  if (name == "f_e") return OldroydBUpdate::f_e;
+  throw InputError("unknown strain update '" + name + "' (expected paper, spd or f_e)");
 }
 
 const ParameterTable<OldroydBParameters>& OldroydBParameters::table() {
   static const ParameterTable<OldroydBParameters> t = [] {
     ParameterTable<OldroydBParameters> table;
     using P = OldroydBParameters;
-    table.real(&P::density, "Density", 1.0, Range::positive(), "mass density ρ [kg/m^3]")
-        .real(&P::shear_modulus, "Shear modulus", 1.0, Range::non_negative(),
-              "Neo-Hookean μ of (5.8) [Pa]")
-        .real(&P::lame_lambda, "Lame lambda", 1.0, Range::non_negative(),
-              "Neo-Hookean λ of (5.8) [Pa]")
-        .real(&P::newtonian_viscosity, "Newtonian viscosity", 0.0, Range::non_negative(),
-              "μ^N of (5.11) in the paper convention [Pa], η in the physical one [Pa s]")
-        .string(&P::viscosity_convention, "Viscosity convention", "physical", {"paper", "physical"},
-                "paper: Φ^N = μ^N ε̂:ε̂ V^n exactly as (5.11); physical: σ^N = 2ηε")
-        .real(&P::weissenberg, "Weissenberg number", 1.0, Range::positive(),
-              "relaxation time Wi of b_OB toward I (§5.4.3) [s]");
+    add_elastic_parameters(table, "(5.8)");
+    add_newtonian_parameters(table);
+    table.real(&P::weissenberg, "Weissenberg number", 1.0, Range::positive(),
+              "relaxation time Wi of b_OB toward I (§5.4.3) [s]")
+        .string(&P::strain_update, "Strain update", "paper", {"paper", "spd", "f_e"},
+                "b_OB update: paper (5.14); spd, positive definite for all Δt (§4.6.1); f_e, stores f_e with "
+                "b_OB = f_e f_e^T (§4.7.1)");
     return table;
   }();
   return t;
@@ -38,17 +36,6 @@ namespace {
 
 // a[(i,j)] = (M^{-T})_{ij}
 Vec9 inverse_transpose_vec(const Mat3& inverse) { return vec(inverse.transpose()); }
-
-// Q[(i,j),(m,n)] = M^{-1}_{jm} M^{-1}_{ni}: minus the derivative of M^{-T} with respect to M.
-Mat9 inverse_derivative(const Mat3& inverse) {
-  Mat9 q;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int m = 0; m < 3; ++m)
-        for (int n = 0; n < 3; ++n)
-          q(vec_index(i, j), vec_index(m, n)) = inverse(j, m) * inverse(n, i);
-  return q;
-}
 
 // The scalar e = μ/2 J^{2/3} det(S)^{-1/3} tr(S): the trace term of ψ(b^E).
 double trace_term(double mu, double J, const Mat3& S) {
@@ -85,8 +72,8 @@ EnergyHessian energy_hessian_blocks(const Coefficients& c, const Mat3& F, const 
   const Vec9 a = inverse_transpose_vec(F_inv);
   const Vec9 s = inverse_transpose_vec(S_inv);
   const Vec9 iota = vec(Mat3::Identity());
-  const Mat9 Q_F = inverse_derivative(F_inv);
-  const Mat9 Q_S = inverse_derivative(S_inv);
+  const Mat9 Q_F = inverse_transpose_derivative(F_inv);
+  const Mat9 Q_S = inverse_transpose_derivative(S_inv);
   const Vec9 dlog_e_dS = -s / 3.0 + iota / T;  // ∂ ln e / ∂S
   const Mat9 aa = a * a.transpose();
 
@@ -120,101 +107,99 @@ Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const 
   return m;
 }
 
-Mat3 predicted_b_ob(const Mat3& S, const Mat3& A, double dt, double weissenberg) {
-  const Mat3 B = A * S;
-  return S + dt / weissenberg * (Mat3::Identity() - S) + B + B.transpose();
-}
-
 Mat3 elastic_left_cauchy_green(const Mat3& F, const Mat3& b_ob) {
   const double J = F.determinant();
   return std::cbrt(J * J / b_ob.determinant()) * b_ob;
 }
 
+bool evaluate_potential(const Coefficients& c, const Mat3& F_n, const FlowStrainMap& map, const Mat3& A,
+                        double dt, double volume, int order, PotentialDerivatives& out) {
+  // Cached quantities: the predicted strains of (5.12), of the b update, and ε̂.
+  const Mat3 F_hat = (Mat3::Identity() + A) * F_n;
+  const Mat3 S_hat = map.predict(A);
+  const Mat3 eps_hat = 0.5 * (A + A.transpose()) / dt;
+  if (!feasible(F_hat, S_hat)) return false;
+  out.energy = volume * energy_density(c, F_hat, S_hat, eps_hat);
+  if (order < 1) return true;
+
+  // ∂Φ/∂A = V Lᵀ ∂Ψ/∂y.
+  using Strain = StrainChainRule::Strain;
+  const StrainChainRule chain{F_n, map.jacobian_factor(A), dt};
+  const EnergyGradient g = energy_gradient_blocks(c, F_hat, S_hat, eps_hat);
+  out.gradient = volume * (chain.pull_back(Strain::F, g.F) + chain.pull_back(Strain::S, g.S) +
+                           chain.pull_back(Strain::eps, g.eps));
+  if (order < 2) return true;
+
+  // ∂²Φ/∂A² = V (Lᵀ (∂²Ψ/∂y²) L + ∂Ψ/∂S : ∂²Ŝ/∂A²); the last term only for a quadratic Ŝ(A).
+  const EnergyHessian h = energy_hessian_blocks(c, F_hat, S_hat);
+  const Mat9 cross = chain.sandwich(Strain::F, h.FS, Strain::S);
+  out.hessian = volume * (chain.sandwich(Strain::F, h.FF, Strain::F) + cross + cross.transpose() +
+                          chain.sandwich(Strain::S, h.SS, Strain::S) +
+                          h.eps_eps * chain.sandwich(Strain::eps, Mat9::Identity(), Strain::eps));
+  if (map.quadratic) out.hessian += volume * kronecker(map.K2, g.S + g.S.transpose());
+  return true;
+}
+
 }  // namespace oldroyd_b
-
-namespace {
-// The chain rule from y = (F̂, Ŝ, ε̂) to A. With dF̂ = dA F^n, dŜ = dA S + S dAᵀ and
-// dε̂ = (dA + dAᵀ)/(2Δt), left multiplication by the transposed Jacobian Lᵀ acts on each column
-// of a 9×N matrix reshaped as a 3×3 matrix C: C Fⁿᵀ, (C + Cᵀ) S, (C + Cᵀ)/(2Δt).
-enum class Strain { F, S, eps };
-
-struct ChainRule {
-  const Mat3& F_n;
-  const Mat3& S_n;
-  double dt;
-
-  Mat3 pull_back(Strain y, const Mat3& C) const {
-    switch (y) {
-      case Strain::F: return C * F_n.transpose();
-      case Strain::S: return (C + C.transpose()) * S_n;
-      case Strain::eps: return (C + C.transpose()) / (2.0 * dt);
-    }
-    return C;
-  }
-  // Lᵀ_y X, column by column.
-  Mat9 left(Strain y, const Mat9& X) const {
-    Mat9 out;
-    for (int k = 0; k < 9; ++k) out.col(k) = vec(pull_back(y, unvec(X.col(k))));
-    return out;
-  }
-  // Lᵀ_a X L_b.
-  Mat9 sandwich(Strain a, const Mat9& X, Strain b) const {
-    return left(a, left(b, X.transpose()).transpose());
-  }
-};
-}  // namespace
 
 OldroydB::OldroydB(std::string name, const OldroydBParameters& parameters)
     : Material(std::move(name)),
       parameters_(parameters),
-      convention_(viscosity_convention_from_name(parameters.viscosity_convention)) {}
+      convention_(viscosity_convention_from_name(parameters.viscosity_convention)),
+      update_(oldroyd_b_update_from_name(parameters.strain_update)) {}
 
 double OldroydB::wave_speed() const {
-  return std::sqrt((parameters_.lame_lambda + 2.0 * parameters_.shear_modulus) / parameters_.density);
+  return elastic_wave_speed(parameters_.density, parameters_.shear_modulus, parameters_.lame_lambda);
+}
+
+std::vector<std::string> OldroydB::state_fields() const {
+  if (update_ == OldroydBUpdate::f_e)
+    return {"deformation_gradient", "elastic_deformation_gradient", "left_cauchy_green_ob"};
+  return {"deformation_gradient", "left_cauchy_green_ob"};
 }
 
 double OldroydB::viscous_coefficient(double dt) const {
-  return convention_ == ViscosityConvention::paper ? parameters_.newtonian_viscosity
-                                                   : dt * parameters_.newtonian_viscosity;
+  return materials::viscous_coefficient(convention_, parameters_.newtonian_viscosity, dt);
+}
+
+FlowStrainMap OldroydB::flow_strain_map(const particles::ParticleSet& particles, std::size_t p, double dt) const {
+  const double wi = parameters_.weissenberg;
+  switch (update_) {
+    case OldroydBUpdate::paper: return flow_strain_map_paper(particles.left_cauchy_green_ob[p], dt, wi);
+    case OldroydBUpdate::spd: return flow_strain_map_spd(particles.left_cauchy_green_ob[p], dt, wi);
+    case OldroydBUpdate::f_e: return flow_strain_map_fe(particles.elastic_deformation_gradient[p], dt, wi);
+  }
+  return {};
 }
 
 bool OldroydB::evaluate(const particles::ParticleSet& particles, std::size_t p, const Mat3& A,
                         const StepContext& step, int order, PotentialDerivatives& out) const {
   const Mat3& F_n = particles.deformation_gradient[p];
-  const Mat3& S_n = particles.left_cauchy_green_ob[p];
-  const double volume = particles.volume0[p];
-  // Cached quantities: the predicted strains of (5.12), (5.14) and ε̂.
-  const Mat3 F_hat = (Mat3::Identity() + A) * F_n;
-  const Mat3 S_hat = oldroyd_b::predicted_b_ob(S_n, A, step.dt, parameters_.weissenberg);
-  const Mat3 eps_hat = 0.5 * (A + A.transpose()) / step.dt;
-  if (!oldroyd_b::feasible(F_hat, S_hat)) return false;
+  if (update_ == OldroydBUpdate::f_e) {
+    // f̂ = (I + A) f + (Δt/2Wi)(f^{-T} − f) must stay orientation preserving (§4.7.1).
+    const Mat3& f = particles.elastic_deformation_gradient[p];
+    const Mat3 f_hat = predicted_fe_offset(f, step.dt, parameters_.weissenberg) + A * f;
+    if (!(f_hat.determinant() > 0.0)) return false;
+  }
   const oldroyd_b::Coefficients c{parameters_.shear_modulus, parameters_.lame_lambda,
                                   viscous_coefficient(step.dt), F_n.determinant()};
-  out.energy = volume * oldroyd_b::energy_density(c, F_hat, S_hat, eps_hat);
-  if (order < 1) return true;
-
-  // ∂Φ/∂A = V Lᵀ ∂Ψ/∂y.
-  const ChainRule chain{F_n, S_n, step.dt};
-  const oldroyd_b::EnergyGradient g = oldroyd_b::energy_gradient_blocks(c, F_hat, S_hat, eps_hat);
-  out.gradient = volume * (chain.pull_back(Strain::F, g.F) + chain.pull_back(Strain::S, g.S) +
-                           chain.pull_back(Strain::eps, g.eps));
-  if (order < 2) return true;
-
-  // F̂, Ŝ and ε̂ are affine in A, so ∂²Φ/∂A² = V Lᵀ (∂²Ψ/∂y²) L.
-  const oldroyd_b::EnergyHessian h = oldroyd_b::energy_hessian_blocks(c, F_hat, S_hat);
-  const Mat9 cross = chain.sandwich(Strain::F, h.FS, Strain::S);
-  out.hessian = volume * (chain.sandwich(Strain::F, h.FF, Strain::F) + cross + cross.transpose() +
-                          chain.sandwich(Strain::S, h.SS, Strain::S) +
-                          h.eps_eps * chain.sandwich(Strain::eps, Mat9::Identity(), Strain::eps));
-  return true;
+  return oldroyd_b::evaluate_potential(c, F_n, flow_strain_map(particles, p, step.dt), A, step.dt,
+                                       particles.volume0[p], order, out);
 }
 
 void OldroydB::update_state(particles::ParticleSet& particles, std::size_t p, const Mat3& A,
                             const StepContext& step) const {
   Mat3& F = particles.deformation_gradient[p];
   Mat3& S = particles.left_cauchy_green_ob[p];
-  S = oldroyd_b::predicted_b_ob(S, A, step.dt, parameters_.weissenberg);  // (5.14)
-  F = (Mat3::Identity() + A) * F;                                         // (5.12)
+  if (update_ == OldroydBUpdate::f_e) {
+    // §4.7.1: f_e^{n+1} = f_e + A f_e + (Δt/2Wi)(f_e^{-T} − f_e); b_OB = f_e f_eᵀ.
+    Mat3& f = particles.elastic_deformation_gradient[p];
+    f = predicted_fe_offset(f, step.dt, parameters_.weissenberg) + A * f;
+    S = f * f.transpose();
+  } else {
+    S = flow_strain_map(particles, p, step.dt).predict(A);  // (5.14) or §4.6.1
+  }
+  F = (Mat3::Identity() + A) * F;  // (5.12)
 }
 
 Mat3 OldroydB::left_cauchy_green_elastic(const particles::ParticleSet& particles, std::size_t p) const {

@@ -51,6 +51,10 @@ void ParticleSet::add(ParticleId pid, const Vec3& x, const Vec3& v, double m, do
   affine_velocity.push_back(Mat3::Zero());
   deformation_gradient.push_back(Mat3::Identity());
   left_cauchy_green_ob.push_back(Mat3::Identity());
+  elastic_deformation_gradient.push_back(Mat3::Identity());
+  plastic_deformation_gradient.push_back(Mat3::Identity());
+  yield_function.push_back(0.0);
+  equivalent_plastic_strain.push_back(0.0);
   mass.push_back(m);
   volume0.push_back(v0);
   material_id.push_back(material);

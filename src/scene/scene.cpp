@@ -264,7 +264,11 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
     const auto* entry = materials::find_model(model_value.string("Model"));
     std::vector<ParameterSpec> specs = {model_spec()};
     specs.insert(specs.end(), entry->parameters.begin(), entry->parameters.end());
-    scene.materials.push_back({name, entry->model, read_parameters(list, specs, file, path)});
+    ParameterValues values = read_parameters(list, specs, file, path);
+    if (entry->check)
+      if (const auto problem = entry->check(values))
+        throw InputError(file + ": parameter '" + path + "/" + problem->parameter + "': " + problem->reason);
+    scene.materials.push_back({name, entry->model, std::move(values)});
   });
   for_each_item(*root, "Bodies", file, [&](const std::string& name, const Teuchos::ParameterList& list,
                                            const std::string& path) {

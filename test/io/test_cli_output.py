@@ -90,6 +90,9 @@ for frame in range(3):
                     "mass": ((n,), np.float64), "volume0": ((n,), np.float64), "material_id": ((n,), np.int32),
                     "deformation_gradient": ((n, 3, 3), np.float64),
                     "left_cauchy_green_ob": ((n, 3, 3), np.float64),
+                    "elastic_deformation_gradient": ((n, 3, 3), np.float64),
+                    "plastic_deformation_gradient": ((n, 3, 3), np.float64),
+                    "yield_function": ((n,), np.float64), "equivalent_plastic_strain": ((n,), np.float64),
                     "left_cauchy_green_elastic": ((n, 3, 3), np.float64)}
         for name, (shape, dtype) in expected.items():
             check(name in p and p[name].shape == shape and p[name].dtype == dtype,
@@ -131,6 +134,30 @@ if os.path.exists(csv_path):
     check(all(float(r[3]) < 1e-5 for r in rows), "relative residuals meet the solver tolerance")
     newton_total = int(result.stdout.split("Newton iterations")[0].split(",")[-1]) if "Newton iterations" in result.stdout else -1
     check(len(rows) == newton_total, f"one row per Newton iteration: {len(rows)} vs {newton_total}")
+
+# A scene of a plastic model: the frame shows its state (doc/materials.md). The snowball of
+# svd_plasticity on a coarse grid, two frames to the middle of its impact: F = F_E F_P, the
+# singular values of F_E clamped to [1 - c, 1 + s], plastic flow (yield function > 0) and
+# compression (J_P < 1), and b^E = F_E F_E^T.
+snow_out = os.path.join(args.workdir, "snowball")
+snow_scene = os.path.join(args.inputs, "scenes", "svd_plasticity_snowball.xml")
+result = run(snow_scene, "--output", snow_out, "--frames", "2", "--set", "Grid/Cell size=0.06",
+             "--set", "Simulation/Frame rate=24")
+check(result.returncode == 0, f"snowball run exits 0, got {result.returncode}: {result.stderr[-2000:]}")
+snow_frame = os.path.join(snow_out, "frame_00002.h5")
+if os.path.exists(snow_frame):
+    with h5py.File(snow_frame, "r") as f:
+        p = f["particles"]
+        F, F_E, F_P = (p[name][...] for name in ("deformation_gradient", "elastic_deformation_gradient",
+                                                 "plastic_deformation_gradient"))
+        check(np.allclose(F, F_E @ F_P, rtol=0, atol=1e-10 * np.abs(F).max()), "F = F_E F_P")
+        sigma = np.linalg.svd(F_E, compute_uv=False)
+        check(sigma.min() >= 1 - 2.5e-2 - 1e-12 and sigma.max() <= 1 + 7.5e-3 + 1e-12,
+              f"singular values of F_E in [1 - c, 1 + s]: {sigma.min()}, {sigma.max()}")
+        check((p["yield_function"][...] > 0).any(), "the snowball flows plastically on impact (t = 1/12 s)")
+        check(np.linalg.det(F_P).min() < 0.99, "plastic compression: J_P < 1")
+        check(np.allclose(p["left_cauchy_green_elastic"][...], F_E @ np.transpose(F_E, (0, 2, 1)), atol=1e-12),
+              "b^E = F_E F_E^T")
 
 # A run that fails keeps the frames written so far: exit 3.
 failed_out = os.path.join(args.workdir, "failed")

@@ -3,11 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
+#include <tuple>
 #include <fstream>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/materials/registry.hpp"
 #include "viscompm/scene/command_line.hpp"
 #include "viscompm/scene/scene.hpp"
 
@@ -98,6 +101,61 @@ TEST(Scene, UnknownSectionAndUnknownModelAreRejected) {
   expect_one_line_naming(read_error(file), file, "Materials/sponge/Model");
   file = variant("name=\"Material\" type=\"string\" value=\"sponge\"", "name=\"Material\" type=\"string\" value=\"foam\"");
   expect_one_line_naming(read_error(file), file, "Bodies/sponge/Material");
+}
+
+TEST(Scene, EveryModelValidatesItsParametersNamingTheMaterialAndTheParameter) {
+  // One out-of-range value per model: exit code 2 with "FILE: parameter 'Materials/<name>/<param>'".
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {"oldroyd_b", "Weissenberg number", "0"},      {"oldroyd_b", "Strain update", "implicit"},
+      {"oldroyd_b", "Shear modulus", "-1"},          {"herschel_bulkley", "Flow index", "0"},
+      {"herschel_bulkley", "Plastic viscosity", "0"}, {"herschel_bulkley", "Yield stress", "-0.1"},
+      {"bingham", "Yield stress", "-1"},             {"neo_hookean", "Density", "0"},
+      {"svd_plasticity", "Critical compression", "1"}, {"svd_plasticity", "Critical stretch", "0"},
+      {"von_mises", "Yield stress", "0"},            {"von_mises", "Hardening modulus", "-5"}};
+  // The default scene with its material replaced by one of `model` with default parameters.
+  auto with_model = [](const std::string& model) {
+    const std::string text = read_text(default_scene);
+    const auto begin = text.find("<ParameterList name=\"Materials\">");
+    const auto end = text.find("<ParameterList name=\"Bodies\">");
+    return variant(text.substr(begin, end - begin),
+                   "<ParameterList name=\"Materials\"><ParameterList name=\"sponge\"><Parameter name=\"Model\" "
+                   "type=\"string\" value=\"" + model + "\"/></ParameterList></ParameterList>\n  ");
+  };
+  for (const auto& [model, parameter, value] : cases) {
+    const std::string file = with_model(model);
+    EXPECT_NO_THROW(scene::read_scene(file)) << model << " with its defaults";
+    const std::string message = read_error(file, {{"Materials/sponge/" + parameter, value}});
+    expect_one_line_naming(message, file, "Materials/sponge/" + parameter);
+  }
+  // A parameter of another model is unknown to this one.
+  const std::string file = variant("value=\"oldroyd_b\"/>", "value=\"neo_hookean\"/>");
+  expect_one_line_naming(read_error(file), file, "Materials/sponge/Newtonian viscosity");
+}
+
+TEST(Scene, CrossParameterCheckRejectsANegativeBulkModulus) {
+  // λ may be negative (an auxetic foam), but λ + 2μ/3 must stay positive.
+  EXPECT_NO_THROW(scene::read_scene(default_scene, {{"Materials/sponge/Lame lambda", "-200"}}));
+  const std::string message = read_error(default_scene, {{"Materials/sponge/Lame lambda", "-240"}});
+  expect_one_line_naming(message, default_scene, "Materials/sponge/Lame lambda");
+  EXPECT_NE(message.find("bulk modulus"), std::string::npos) << message;
+}
+
+TEST(Scene, EverySceneFileParsesAndEveryModelHasAScene) {
+  std::set<std::string> models_in_scenes;
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(inputs + "/scenes")) {
+    if (entry.path().extension() != ".xml") continue;
+    ++scenes;
+    scene::SceneConfig s;
+    EXPECT_NO_THROW(s = scene::read_scene(entry.path().string())) << entry.path();
+    EXPECT_TRUE(std::filesystem::exists(s.solver_file)) << entry.path();
+    for (const auto& m : s.materials) models_in_scenes.insert(m.model);
+    // Each scene can be built: its materials from the registry.
+    for (const auto& m : s.materials) EXPECT_NO_THROW(materials::find_model(m.model)->create(m.name, m.values));
+  }
+  EXPECT_GE(scenes, 7);
+  for (const auto& model : materials::model_names())
+    EXPECT_TRUE(models_in_scenes.count(model)) << "no scene in inputs/scenes uses " << model;
 }
 
 TEST(Scene, MissingFileAndMalformedXmlAreInputErrors) {

@@ -6,6 +6,7 @@
 
 #include "viscompm/linalg/linear_solver.hpp"
 #include "viscompm/materials/oldroyd_b.hpp"
+#include "viscompm/materials/registry.hpp"
 #include "viscompm/scene/scene.hpp"
 
 namespace viscompm::testkit {
@@ -107,6 +108,57 @@ inline scene::SceneConfig sponge_scene() {
   bullet.contact = "slip";
   bullet.velocity = Vec3(3, 0, 0);
   scene.colliders.push_back(bullet);
+  return scene;
+}
+
+/// A material of any registered model: its declared defaults, overridden by `values`.
+inline scene::MaterialSettings model_material(const std::string& name, const std::string& model,
+                                              const std::vector<std::pair<std::string, ParameterValue>>& values) {
+  scene::MaterialSettings m;
+  m.name = name;
+  m.model = model;
+  for (const auto& spec : materials::find_model(model)->parameters) m.values.set(spec.name, spec.default_value);
+  for (const auto& [parameter, value] : values) m.values.set(parameter, value);
+  return m;
+}
+
+// Every model in one scene (the pie of Figure 5.8 has a stiff crust and a soft cream): blocks of
+// each thrown at a sticky table and at each other, with gravity, so that all of them deform,
+// flow plastically and migrate between ranks.
+inline scene::SceneConfig mixed_models_scene() {
+  auto scene = base_scene(Vec3(1.2, 0.8, 0.5), 0.05);
+  scene.simulation.gravity = Vec3(0.0, -9.81, 0.0);
+  scene.simulation.max_time_step = 4e-3;
+  scene.newton.tolerance = 1e-10;
+  const std::pair<std::string, ParameterValue> rho{"Density", 1.0}, mu{"Shear modulus", 200.0},
+      lambda{"Lame lambda", 800.0};
+  scene.materials.push_back(model_material("crust", "neo_hookean", {rho, {"Shear modulus", 2000.0}, {"Lame lambda", 8000.0}}));
+  scene.materials.push_back(model_material("cream", "oldroyd_b", {rho, {"Shear modulus", 5.0}, {"Lame lambda", 50.0},
+                                                                  {"Weissenberg number", 0.05}, {"Strain update", std::string("spd")},
+                                                                  {"Newtonian viscosity", 0.01}}));
+  scene.materials.push_back(model_material("goo", "oldroyd_b", {rho, mu, lambda, {"Weissenberg number", 0.1},
+                                                                {"Strain update", std::string("f_e")}}));
+  scene.materials.push_back(model_material("foam", "herschel_bulkley", {rho, mu, lambda, {"Yield stress", 0.02},
+                                                                        {"Plastic viscosity", 0.05}, {"Flow index", 0.6}}));
+  scene.materials.push_back(model_material("paste", "bingham", {rho, mu, lambda, {"Yield stress", 0.02},
+                                                                {"Plastic viscosity", 0.05}}));
+  scene.materials.push_back(model_material("snow", "svd_plasticity", {rho, mu, lambda, {"Critical compression", 0.01},
+                                                                      {"Critical stretch", 0.005}, {"Hardening coefficient", 10.0}}));
+  scene.materials.push_back(model_material("metal", "von_mises", {rho, mu, lambda, {"Yield stress", 2.0},
+                                                                  {"Hardening modulus", 50.0}}));
+  const double y0 = 0.25, size = 0.15;
+  const char* names[] = {"crust", "goo", "foam", "paste", "snow", "metal"};
+  for (int k = 0; k < 6; ++k) {
+    const Vec3 lo(0.12 + 0.16 * k, y0, 0.15);
+    auto body = box_body(names[k], lo, lo + Vec3(0.14, size, size), Vec3(k % 2 ? -1.5 : 1.5, -2.0, 0.0));
+    body.name = names[k];
+    scene.bodies.push_back(body);
+  }
+  // The cream sits on the crust.
+  auto cream = box_body("cream", Vec3(0.12, y0 + size, 0.15), Vec3(0.26, y0 + size + 0.1, 0.3), Vec3(1.5, -2.0, 0.0));
+  cream.name = "cream";
+  scene.bodies.push_back(cream);
+  scene.colliders.push_back(box_collider("table", "sticky", Vec3(0.0, 0.0, 0.0), Vec3(1.2, 0.2, 0.5)));
   return scene;
 }
 

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "viscompm/core/types.hpp"
 #include "viscompm/particles/particle_set.hpp"
@@ -36,6 +37,9 @@ class Material {
   virtual double density() const = 0;
   /// Speed of the fastest elastic wave, √((λ + 2μ)/ρ), for time-step diagnostics.
   virtual double wave_speed() const = 0;
+  /// The per-particle fields (ParticleSet / HDF5 dataset names) this model's state lives in:
+  /// what evaluate reads and update_state writes, besides position, velocity, mass and volume.
+  virtual std::vector<std::string> state_fields() const = 0;
 
   /// Evaluates Φ_p(A) and, for order ≥ 1, its gradient and, for order 2, its Hessian.
   /// Returns false (and leaves `out` unspecified) if A makes the particle's state infeasible:
@@ -43,7 +47,9 @@ class Material {
   virtual bool evaluate(const particles::ParticleSet& particles, std::size_t p, const Mat3& A,
                         const StepContext& step, int order, PotentialDerivatives& out) const = 0;
 
-  /// After the solve: stores the strains predicted by the final A (the same maps as evaluate).
+  /// After the solve: stores the strains predicted by the final A (the same maps as evaluate),
+  /// then applies the model's explicit plastic correction if it has one (§4.4, §4.3: the return
+  /// mappings of svd_plasticity and von_mises act after the solve, as in Stomakhin et al. 2013).
   virtual void update_state(particles::ParticleSet& particles, std::size_t p, const Mat3& A,
                             const StepContext& step) const = 0;
 

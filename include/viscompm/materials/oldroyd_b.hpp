@@ -1,5 +1,8 @@
 // The volume-preserving Oldroyd-B model of Chapter 5: Neo-Hookean elasticity (5.8) of
-// b^E = (J / J_OB)^{2/3} b_OB (5.5, 5.13), b_OB updated by the upper-convected scheme (5.14),
+// b^E = (J / J_OB)^{2/3} b_OB (5.5, 5.13), b_OB updated by one of three schemes ("Strain update"):
+//   paper: the upper-convected scheme (5.14), linear in A;
+//   spd:   the update of §4.6.1, b_OB symmetric positive definite for every Δt (quadratic in A);
+//   f_e:   the recast of §4.7.1, which stores f_e and b_OB = f_e f_e^T (quadratic in A);
 // plus the Newtonian viscous potential (5.11) in one of two conventions (DESIGN.md §3):
 //   paper:    Φ^N = μ^N ε̂:ε̂ V^n        (μ^N acts as a viscosity μ^N / Δt)
 //   physical: Φ^N = Δt η ε̂:ε̂ V^n       (σ^N = 2 η ε, independent of Δt)
@@ -9,19 +12,17 @@
 
 #include "viscompm/core/parameters.hpp"
 #include "viscompm/materials/material.hpp"
+#include "viscompm/materials/shared_parameters.hpp"
+#include "viscompm/materials/strain_maps.hpp"
 
 namespace viscompm::materials {
 
-enum class ViscosityConvention { paper, physical };
-ViscosityConvention viscosity_convention_from_name(const std::string& name);
+enum class OldroydBUpdate { paper, spd, f_e };
+OldroydBUpdate oldroyd_b_update_from_name(const std::string& name);
 
-struct OldroydBParameters {
-  double density = 1.0;
-  double shear_modulus = 1.0;         ///< μ
-  double lame_lambda = 1.0;           ///< λ
-  double newtonian_viscosity = 0.0;   ///< μ^N (paper) or η (physical)
-  std::string viscosity_convention = "physical";
+struct OldroydBParameters : ElasticParameters, NewtonianParameters {
   double weissenberg = 1.0;           ///< Wi
+  std::string strain_update = "paper";
 
   static const ParameterTable<OldroydBParameters>& table();
 };
@@ -62,10 +63,14 @@ EnergyHessian energy_hessian_blocks(const Coefficients& c, const Mat3& F, const 
 Vec27 energy_gradient(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps);
 
-/// Ŝ(A) of (5.14): S + A S + S A^T + (Δt/Wi)(I − S).
-Mat3 predicted_b_ob(const Mat3& S, const Mat3& A, double dt, double weissenberg);
 /// b^E = (J / J_OB)^{2/3} b_OB of (5.5).
 Mat3 elastic_left_cauchy_green(const Mat3& F, const Mat3& b_ob);
+
+/// Φ_p = V Ψ(F̂, Ŝ, ε̂) with F̂ = (I + A) F^n (5.12), Ŝ = map(A) and ε̂ = sym(A)/Δt, and its
+/// derivatives in A (order 0, 1, 2). Shared by the Oldroyd-B updates and the Herschel–Bulkley-like
+/// fluid of §4.6.2, which uses "the analogous strain density from Chapter 5". False if infeasible.
+bool evaluate_potential(const Coefficients& c, const Mat3& F_n, const FlowStrainMap& map, const Mat3& A,
+                        double dt, double volume, int order, PotentialDerivatives& out);
 
 }  // namespace oldroyd_b
 
@@ -76,9 +81,13 @@ class OldroydB : public Material {
   std::string model() const override { return "oldroyd_b"; }
   double density() const override { return parameters_.density; }
   double wave_speed() const override;
+  std::vector<std::string> state_fields() const override;
   const OldroydBParameters& parameters() const { return parameters_; }
+  OldroydBUpdate update() const { return update_; }
   /// c_N of the viscous potential for a step of size dt.
   double viscous_coefficient(double dt) const;
+  /// Ŝ(A) of this model's update for particle p (b_OB of the step, or f_e for the f_e update).
+  FlowStrainMap flow_strain_map(const particles::ParticleSet& particles, std::size_t p, double dt) const;
 
   bool evaluate(const particles::ParticleSet& particles, std::size_t p, const Mat3& A,
                 const StepContext& step, int order, PotentialDerivatives& out) const override;
@@ -89,6 +98,7 @@ class OldroydB : public Material {
  private:
   OldroydBParameters parameters_;
   ViscosityConvention convention_;
+  OldroydBUpdate update_;
 };
 
 }  // namespace viscompm::materials

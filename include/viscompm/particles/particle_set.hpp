@@ -16,7 +16,14 @@ struct ParticleSet {
   std::vector<Vec3> velocity;                 ///< v_p
   std::vector<Mat3> affine_velocity;          ///< C_p = B_p D_p^{-1} of APIC (zero for PIC/FLIP)
   std::vector<Mat3> deformation_gradient;     ///< F_p
-  std::vector<Mat3> left_cauchy_green_ob;     ///< b_OB^E of §5.4.4 (the stored S of Appendix A)
+  std::vector<Mat3> left_cauchy_green_ob;     ///< b_OB^E of §5.4.4 (the stored S of Appendix A); b_HB of
+                                              ///< §4.6.2 for the Herschel–Bulkley-like models
+  std::vector<Mat3> elastic_deformation_gradient;  ///< F_E of §4.1 (svd_plasticity, von_mises); the f_e of
+                                                   ///< §4.7 for oldroyd_b with the f_e update
+  std::vector<Mat3> plastic_deformation_gradient;  ///< F_P of §4.1, F = F_E F_P (svd_plasticity, von_mises)
+  std::vector<double> yield_function;         ///< the model's yield function at its last strain update:
+                                              ///< > 0 when that step flowed plastically (doc/materials.md)
+  std::vector<double> equivalent_plastic_strain;  ///< accumulated plastic strain (von_mises: ε of §4.2.6)
   std::vector<double> mass;                   ///< m_p
   std::vector<double> volume0;                ///< V_p^0
   std::vector<int> material_id;               ///< index into the scene's material list
@@ -30,7 +37,7 @@ struct ParticleSet {
   template <class F>
   void for_each_field(F&& f) const { visit_fields(*this, f); }
 
-  /// Appends one particle with identity strains and zero affine velocity.
+  /// Appends one particle with identity strains, no plastic history and zero affine velocity.
   void add(ParticleId pid, const Vec3& x, const Vec3& v, double m, double v0, int material);
   void resize(std::size_t n);
   /// Keeps particle order[k] at position k (order may be a subset: the rest is dropped).
@@ -47,6 +54,10 @@ struct ParticleSet {
     f("affine_velocity", self.affine_velocity);
     f("deformation_gradient", self.deformation_gradient);
     f("left_cauchy_green_ob", self.left_cauchy_green_ob);
+    f("elastic_deformation_gradient", self.elastic_deformation_gradient);
+    f("plastic_deformation_gradient", self.plastic_deformation_gradient);
+    f("yield_function", self.yield_function);
+    f("equivalent_plastic_strain", self.equivalent_plastic_strain);
     f("mass", self.mass);
     f("volume0", self.volume0);
     f("material_id", self.material_id);
