@@ -20,12 +20,17 @@ for r in rows:
          r["converged"] == "1"))
 
 fig, (ax_it, ax_t) = plt.subplots(1, 2, figsize=(12, 5))
+# One colour per configuration, one line style per time step.
+labels = sorted({label for label, _ in series})
+steps = sorted({step for _, step in series})
+colours = {label: plt.get_cmap("tab10")(k % 10) for k, label in enumerate(labels)}
+styles = {step: ["-", "--", ":", "-."][k % 4] for k, step in enumerate(steps)}
 for (label, step), points in sorted(series.items()):
     points.sort()
     dofs = [p[0] for p in points]
-    style = dict(marker="o", label=f"{label} (dt={step})")
-    line, = ax_it.plot(dofs, [p[1] for p in points], **style)
-    ax_t.plot(dofs, [p[2] for p in points], color=line.get_color(), marker="o")
+    style = dict(marker="o", color=colours[label], linestyle=styles[step], label=f"{label} (dt={step})")
+    ax_it.plot(dofs, [p[1] for p in points], **style)
+    ax_t.plot(dofs, [p[2] for p in points], **style)
     failed = [p for p in points if not p[3]]
     if failed:
         ax_it.plot([p[0] for p in failed], [p[1] for p in failed], "x", color="red", markersize=10)
