@@ -11,11 +11,28 @@
 
 namespace viscompm::app {
 
+int run_with_exit_codes(const std::string& program, const parallel::Communicator& comm,
+                        const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const InputError& e) {
+    if (comm.is_root()) std::cerr << program << ": " << e.what() << std::endl;
+    return exit_bad_input;
+  } catch (const SimulationError& e) {
+    if (comm.is_root()) std::cerr << program << ": failed: " << e.what() << std::endl;
+    return exit_simulation_failed;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
+    MPI_Abort(MPI_COMM_WORLD, exit_simulation_failed);
+    return exit_simulation_failed;
+  }
+}
+
 int run_simulation_program(int argc, char** argv) {
   linalg::Environment environment(&argc, &argv);
   const parallel::Communicator comm(MPI_COMM_WORLD);
   const bool root = comm.is_root();
-  try {
+  return run_with_exit_codes("viscompm", comm, [&] {
     scene::ProgramOptions options;
     options.program = "viscompm";
     options.description =
@@ -47,17 +64,7 @@ int run_simulation_program(int argc, char** argv) {
                 << summary.rebalances << " rebalances\n"
                 << "output: " << scene.output.directory << "/particles.xdmf (ParaView), frame_*.h5, solver.csv\n";
     return exit_success;
-  } catch (const InputError& e) {
-    if (root) std::cerr << "viscompm: " << e.what() << std::endl;
-    return exit_bad_input;
-  } catch (const SimulationError& e) {
-    if (root) std::cerr << "viscompm: simulation failed: " << e.what() << std::endl;
-    return exit_simulation_failed;
-  } catch (const std::exception& e) {
-    std::cerr << "viscompm: internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
-    MPI_Abort(MPI_COMM_WORLD, exit_simulation_failed);
-    return exit_simulation_failed;
-  }
+  });
 }
 
 }  // namespace viscompm::app

@@ -26,7 +26,7 @@ int run_study_program(int argc, char** argv) {
   linalg::Environment environment(&argc, &argv);
   const parallel::Communicator comm(MPI_COMM_WORLD);
   const bool root = comm.is_root();
-  try {
+  return run_with_exit_codes("viscompm-study", comm, [&] {
     scene::ProgramOptions options;
     options.program = "viscompm-study";
     options.input_name = "STUDY.xml";
@@ -59,17 +59,7 @@ int run_study_program(int argc, char** argv) {
       }
     }
     return exit_success;
-  } catch (const InputError& e) {
-    if (root) std::cerr << "viscompm-study: " << e.what() << std::endl;
-    return exit_bad_input;
-  } catch (const SimulationError& e) {
-    if (root) std::cerr << "viscompm-study: failed: " << e.what() << std::endl;
-    return exit_simulation_failed;
-  } catch (const std::exception& e) {
-    std::cerr << "viscompm-study: internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
-    MPI_Abort(MPI_COMM_WORLD, exit_simulation_failed);
-    return exit_simulation_failed;
-  }
+  });
 }
 
 }  // namespace viscompm::app

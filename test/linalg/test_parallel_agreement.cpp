@@ -8,6 +8,7 @@
 #include <map>
 #include <type_traits>
 
+#include "gather.hpp"
 #include "scenes.hpp"
 #include "viscompm/simulation/simulation.hpp"
 
@@ -21,13 +22,7 @@ using ParticleStates = std::map<ParticleId, std::vector<double>>;
 ParticleStates gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
   std::vector<double> local;
   for (std::size_t p = 0; p < ps.size(); ++p) particles::pack_particle(ps, p, local);
-  int ranks = 1, count = static_cast<int>(local.size());
-  MPI_Comm_size(comm, &ranks);
-  std::vector<int> counts(ranks), offsets(ranks, 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-  std::vector<double> all(offsets.back() + counts.back());
-  MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  const std::vector<double> all = testkit::all_gather(local, comm);
   ParticleStates out;
   particles::ParticleSet unpacked;
   particles::unpack_particles(all, unpacked);
@@ -71,14 +66,6 @@ scene::SceneConfig scene_named(const std::string& name) {
 
 class ParallelAgreement : public ::testing::TestWithParam<std::string> {};
 
-// Rank 0 alone, and every rank: the reference and the run under test.
-MPI_Comm solo_communicator() {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm solo;
-  MPI_Comm_split(MPI_COMM_WORLD, rank == 0 ? 0 : MPI_UNDEFINED, 0, &solo);
-  return solo;
-}
 
 using Entries = std::vector<std::tuple<long long, long long, double>>;
 
@@ -100,7 +87,7 @@ TEST_P(ParallelAgreement, AssembledMatrixIsTheSameOnOneRankAndOnAll) {
   std::int64_t n_world = 0, n_solo = 0;
   const Entries all = first_newton_matrix(GetParam(), world, n_world);
   Entries reference;
-  if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
+  if (MPI_Comm solo = testkit::solo_communicator(); solo != MPI_COMM_NULL) {
     reference = first_newton_matrix(GetParam(), parallel::Communicator(solo), n_solo);
     MPI_Comm_free(&solo);
   }
@@ -126,7 +113,7 @@ TEST_P(ParallelAgreement, FullStepsAreTheSameOnOneRankAndOnAll) {
   sim.advance_to(t_end, summary);
   const auto all = gather_particles(sim.particles(), world.comm());
   ParticleStates reference;
-  if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
+  if (MPI_Comm solo = testkit::solo_communicator(); solo != MPI_COMM_NULL) {
     simulation::Simulation solo_sim(scene_named(GetParam()), testkit::jacobi_cg(1e-12), parallel::Communicator(solo));
     simulation::RunSummary solo_summary;
     solo_sim.advance_to(t_end, solo_summary);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <random>
 
+#include "gather.hpp"
 #include "scenes.hpp"
 #include "viscompm/simulation/simulation.hpp"
 
@@ -20,13 +21,6 @@ std::vector<std::string> solver_files() {
   return files;
 }
 
-MPI_Comm solo_communicator() {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm solo;
-  MPI_Comm_split(MPI_COMM_WORLD, rank == 0 ? 0 : MPI_UNDEFINED, 0, &solo);
-  return solo;
-}
 
 // A Newton system of the small sponge with moving parts at a Δt of several elastic CFL limits,
 // solved from zero with `config`; returns the report of the solve.
@@ -59,7 +53,7 @@ TEST(SolverConfigurations, EverySolverFileConvergesWithTheSameIterationsOnOneRan
     EXPECT_LT(report.relative_residual, 1e-5) << file;
     EXPECT_GT(report.iterations, 0) << file;
     int reference_iterations = report.iterations;
-    if (MPI_Comm solo = solo_communicator(); solo != MPI_COMM_NULL) {
+    if (MPI_Comm solo = testkit::solo_communicator(); solo != MPI_COMM_NULL) {
       reference_iterations = solve_sponge_system(config, parallel::Communicator(solo)).iterations;
       MPI_Comm_free(&solo);
     }

@@ -15,15 +15,8 @@ struct ParticleState {
   Mat3 F, b, C;
 };
 
-// All particles of the communicator, by id, on every rank.
-inline std::map<ParticleId, ParticleState> gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
-  std::vector<double> local;
-  for (std::size_t p = 0; p < ps.size(); ++p) {
-    local.push_back(static_cast<double>(ps.id[p]));
-    for (const Vec3* v : {&ps.position[p], &ps.velocity[p]}) local.insert(local.end(), v->data(), v->data() + 3);
-    for (const Mat3* m : {&ps.deformation_gradient[p], &ps.left_cauchy_green_ob[p], &ps.affine_velocity[p]})
-      local.insert(local.end(), m->data(), m->data() + 9);
-  }
+/// Every rank's doubles, concatenated in rank order, on every rank.
+inline std::vector<double> all_gather(const std::vector<double>& local, MPI_Comm comm) {
   int ranks = 1, count = static_cast<int>(local.size());
   MPI_Comm_size(comm, &ranks);
   std::vector<int> counts(ranks), offsets(ranks, 0);
@@ -31,19 +24,29 @@ inline std::map<ParticleId, ParticleState> gather_particles(const particles::Par
   for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
   std::vector<double> all(offsets.back() + counts.back());
   MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  return all;
+}
+
+/// All particles of the communicator (every stored field), on every rank.
+inline particles::ParticleSet gather_particle_set(const particles::ParticleSet& ps, MPI_Comm comm) {
+  std::vector<double> local;
+  for (std::size_t p = 0; p < ps.size(); ++p) particles::pack_particle(ps, p, local);
+  particles::ParticleSet all;
+  particles::unpack_particles(all_gather(local, comm), all);
+  return all;
+}
+
+/// All particles of the communicator, by id, on every rank (throws on a duplicate id).
+inline std::map<ParticleId, ParticleState> gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
+  const particles::ParticleSet all = gather_particle_set(ps, comm);
   std::map<ParticleId, ParticleState> out;
-  for (std::size_t k = 0; k < all.size(); k += 34) {
-    ParticleState s;
-    s.x = Eigen::Map<const Vec3>(&all[k + 1]);
-    s.v = Eigen::Map<const Vec3>(&all[k + 4]);
-    s.F = Eigen::Map<const Mat3>(&all[k + 7]);
-    s.b = Eigen::Map<const Mat3>(&all[k + 16]);
-    s.C = Eigen::Map<const Mat3>(&all[k + 25]);
-    if (!out.emplace(static_cast<ParticleId>(all[k]), s).second) throw std::runtime_error("duplicate particle id");
+  for (std::size_t p = 0; p < all.size(); ++p) {
+    const ParticleState s{all.position[p], all.velocity[p], all.deformation_gradient[p], all.left_cauchy_green_ob[p],
+                          all.affine_velocity[p]};
+    if (!out.emplace(all.id[p], s).second) throw std::runtime_error("duplicate particle id");
   }
   return out;
 }
-
 
 // Rank 0 alone, and every rank: the reference and the run under test.
 inline MPI_Comm solo_communicator() {
