@@ -37,4 +37,10 @@ for n in 1 2; do
   /usr/bin/time -v mpiexec -np $n "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --output "$OUT/demo_np$n" \
     > "$OUT/demo_np$n.txt" 2> "$OUT/demo_np$n.time"
 done
+# 6. MueLu variants (aggregation, dropping, smoothers) against the shipped configuration, Δx = 0.02 and 0.01.
+mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/bench/muelu_variants/study.xml" --output "$OUT/muelu_variants" | tee "$OUT/muelu_variants.txt"
+
+# 7. The largest resolution that fits here (Δx = 0.005, ~16 GB, ~30 minutes).
+/usr/bin/time -v mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/bench/muelu_variants/largest.xml" --output "$OUT/largest" \
+  > "$OUT/largest.txt" 2>&1
 echo "benchmarks in $OUT"
