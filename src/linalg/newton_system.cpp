@@ -136,24 +136,13 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
   if (matrix.is_null()) throw std::logic_error("gather_entries: the operator is matrix-free");
   const auto& A = *matrix;
   const auto& s = impl_->space.impl();
-  const MPI_Comm comm = impl_->space.comm().comm();
-  const int ranks = impl_->space.comm().size();
-  // Gathers doubles from every rank to every rank.
-  auto all_gather = [&](const std::vector<double>& local) {
-    int count = static_cast<int>(local.size());
-    std::vector<int> counts(ranks), offsets(ranks, 0);
-    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-    for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-    std::vector<double> all(offsets.back() + counts.back());
-    MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
-    return all;
-  };
+  const auto& comm = impl_->space.comm();
   // System node id → grid node id, for every node (ids exact in doubles below 2^53).
   std::vector<double> pairs;
   for (std::size_t i = 0; i < s.owned_count; ++i)
     pairs.insert(pairs.end(), {double(s.local_system_ids[i]), double(s.local_nodes[i])});
   std::map<long long, long long> grid_of;
-  const auto all_pairs = all_gather(pairs);
+  const auto all_pairs = comm.all_gather(pairs);
   for (std::size_t k = 0; k < all_pairs.size(); k += 2)
     grid_of[static_cast<long long>(all_pairs[k])] = static_cast<long long>(all_pairs[k + 1]);
   auto grid_dof = [&](long long system_dof) { return 3 * grid_of.at(system_dof / 3) + system_dof % 3; };
@@ -171,7 +160,7 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
       local.push_back(vals(k));
     }
   }
-  const auto all = all_gather(local);
+  const auto all = comm.all_gather(local);
   std::vector<std::tuple<long long, long long, double>> entries;
   for (std::size_t k = 0; k + 2 < all.size(); k += 3)
     entries.emplace_back(grid_dof(static_cast<long long>(all[k])), grid_dof(static_cast<long long>(all[k + 1])),

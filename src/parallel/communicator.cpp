@@ -37,6 +37,27 @@ std::int64_t Communicator::max(std::int64_t local) const {
   return global;
 }
 
+namespace {
+template <typename T>
+std::vector<T> all_gather_values(const std::vector<T>& local, MPI_Datatype type, MPI_Comm comm, int ranks) {
+  const int count = static_cast<int>(local.size());
+  std::vector<int> counts(ranks), offsets(ranks, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<T> all(offsets.back() + counts.back());
+  MPI_Allgatherv(local.data(), count, type, all.data(), counts.data(), offsets.data(), type, comm);
+  return all;
+}
+}  // namespace
+
+std::vector<double> Communicator::all_gather(const std::vector<double>& local) const {
+  return all_gather_values(local, MPI_DOUBLE, comm_, size_);
+}
+
+std::vector<std::int64_t> Communicator::all_gather(const std::vector<std::int64_t>& local) const {
+  return all_gather_values(local, MPI_INT64_T, comm_, size_);
+}
+
 bool Communicator::any(bool local) const {
   int value = local ? 1 : 0;
   int global = 0;

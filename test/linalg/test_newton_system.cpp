@@ -37,13 +37,7 @@ TEST(NewtonSystem, TpetraAssemblyEqualsTheSumOfElementMatricesByGlobalIds) {
       for (int d = 0; d < 3; ++d)
         triplets.insert(triplets.end(), {double(3 * layout.nodes[i] + d), double(3 * layout.nodes[i] + d),
                                          integrator.grid_mass()[i]});
-    int count = static_cast<int>(triplets.size());
-    std::vector<int> counts(comm.size()), offsets(comm.size(), 0);
-    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm.comm());
-    for (int r = 1; r < comm.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-    std::vector<double> all(offsets.back() + counts.back());
-    MPI_Allgatherv(triplets.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
-                   comm.comm());
+    const std::vector<double> all = comm.all_gather(triplets);
     std::map<std::pair<long long, long long>, double> reference;
     for (std::size_t k = 0; k < all.size(); k += 3)
       reference[{static_cast<long long>(all[k]), static_cast<long long>(all[k + 1])}] += all[k + 2];

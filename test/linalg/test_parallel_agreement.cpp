@@ -22,7 +22,7 @@ using ParticleStates = std::map<ParticleId, std::vector<double>>;
 ParticleStates gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
   std::vector<double> local;
   for (std::size_t p = 0; p < ps.size(); ++p) particles::pack_particle(ps, p, local);
-  const std::vector<double> all = testkit::all_gather(local, comm);
+  const std::vector<double> all = parallel::Communicator(comm).all_gather(local);
   ParticleStates out;
   particles::ParticleSet unpacked;
   particles::unpack_particles(all, unpacked);

@@ -63,13 +63,7 @@ Measurement run_couette(const std::string& update) {
   std::vector<ParticleId> local_window;
   for (std::size_t p = 0; p < sim.particles().size(); ++p)
     if (std::abs(sim.particles().position[p].x() - x_center) < 0.1) local_window.push_back(sim.particles().id[p]);
-  int local_count = static_cast<int>(local_window.size());
-  std::vector<int> counts(comm.size()), offsets(comm.size(), 0);
-  MPI_Allgather(&local_count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm.comm());
-  for (int r = 1; r < comm.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-  std::vector<ParticleId> all_window(offsets.back() + counts.back());
-  MPI_Allgatherv(local_window.data(), local_count, MPI_INT64_T, all_window.data(), counts.data(), offsets.data(),
-                 MPI_INT64_T, comm.comm());
+  const std::vector<ParticleId> all_window = comm.all_gather(local_window);
   const std::set<ParticleId> window(all_window.begin(), all_window.end());
   simulation::RunSummary summary;
   sim.advance_to(duration, summary);

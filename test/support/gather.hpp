@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "viscompm/parallel/communicator.hpp"
 #include "viscompm/particles/particle_set.hpp"
 
 namespace viscompm::testkit {
@@ -15,24 +16,12 @@ struct ParticleState {
   Mat3 F, b, C;
 };
 
-/// Every rank's doubles, concatenated in rank order, on every rank.
-inline std::vector<double> all_gather(const std::vector<double>& local, MPI_Comm comm) {
-  int ranks = 1, count = static_cast<int>(local.size());
-  MPI_Comm_size(comm, &ranks);
-  std::vector<int> counts(ranks), offsets(ranks, 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  for (int r = 1; r < ranks; ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-  std::vector<double> all(offsets.back() + counts.back());
-  MPI_Allgatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
-  return all;
-}
-
 /// All particles of the communicator (every stored field), on every rank.
 inline particles::ParticleSet gather_particle_set(const particles::ParticleSet& ps, MPI_Comm comm) {
   std::vector<double> local;
   for (std::size_t p = 0; p < ps.size(); ++p) particles::pack_particle(ps, p, local);
   particles::ParticleSet all;
-  particles::unpack_particles(all_gather(local, comm), all);
+  particles::unpack_particles(parallel::Communicator(comm).all_gather(local), all);
   return all;
 }
 

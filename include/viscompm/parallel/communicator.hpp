@@ -1,10 +1,11 @@
-// A thin value wrapper around an MPI communicator: rank, size and the few reductions the
-// physics layer needs (global sums of energies, maxima of speeds, agreement on decisions).
+// A thin value wrapper around an MPI communicator: rank, size and the few collectives the
+// physics layer needs (global sums of energies, maxima of speeds, agreement on decisions, gathers).
 #pragma once
 
 #include <mpi.h>
 
 #include <cstdint>
+#include <vector>
 
 namespace viscompm::parallel {
 
@@ -22,6 +23,9 @@ class Communicator {
   double max(double local) const;
   double min(double local) const;
   std::int64_t max(std::int64_t local) const;
+  /// Every rank's values, concatenated in rank order, on every rank.
+  std::vector<double> all_gather(const std::vector<double>& local) const;
+  std::vector<std::int64_t> all_gather(const std::vector<std::int64_t>& local) const;
   /// True on every rank if `local` is true on any rank.
   bool any(bool local) const;
   void barrier() const;
