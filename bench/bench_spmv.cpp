@@ -58,11 +58,11 @@ int main(int argc, char** argv) {
   const auto assembled_config = linalg::SolverConfiguration::read(scene.solver_file);
   simulation::Simulation sim(scene, assembled_config, comm);
   auto& integrator = sim.integrator();
-  integrator.build_layout(sim.particles());
-  integrator.particles_to_grid(sim.particles());
   double wave_speed = 0.0;
   for (const auto& m : sim.materials()) wave_speed = std::max(wave_speed, m->wave_speed());
-  const auto objective = integrator.build_objective(sim.particles(), 0.0, dt_cfl * sim.grid().dx / wave_speed);
+  const double dt = dt_cfl * sim.grid().dx / wave_speed;
+  integrator.prepare(sim.particles(), dt);
+  const auto objective = integrator.build_objective(sim.particles(), 0.0, dt);
 
   // Assembled: first assembly (graph build included), second (values only), SpMV.
   auto& assembled = integrator.newton_system();

@@ -101,7 +101,6 @@ NewtonReport newton_solve(const IncrementalPotential& potential, const linalg::N
         report.failure = "infeasible state";
         return report;
       }
-      space.accumulate(g);
     }
     report.residual = velocity_residual(potential, g, comm);
     report.residual_history.push_back(report.residual);

@@ -1,6 +1,8 @@
 // The Newton matrix H = M + Δt² ∇²Φ as a Tpetra operator, in two forms built from the same
-// per-particle pieces: assembled into an FECrsMatrix, or applied matrix-free (the paper's §5.7
-// solver). Private to src/linalg.
+// per-particle pieces: assembled into a CrsMatrix, or applied matrix-free (the paper's §5.7
+// solver). Both are owner computes: owned rows from own and ghost particles. Rows of nodes
+// without mass (the partition's padding) are identity rows scaled by massless_row_scale.
+// Private to src/linalg.
 #pragma once
 
 #include <memory>
@@ -29,7 +31,8 @@ class HessianOperator {
 std::unique_ptr<HessianOperator> make_assembled_hessian(const NodeSpace& space);
 std::unique_ptr<HessianOperator> make_matrix_free_hessian(const NodeSpace& space);
 
-/// Neighbours of every local node: the union of the stencils of the cells containing it (sorted).
-std::vector<std::vector<int>> node_neighbours(const grid::GridLayout& layout);
+/// The diagonal of the rows of nodes without mass: the mean mass of the nodes with mass
+/// (collective), so that those rows are scaled like the others.
+double massless_row_scale(const implicit::IncrementalPotential& potential, const parallel::Communicator& comm);
 
 }  // namespace viscompm::linalg

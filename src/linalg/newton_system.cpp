@@ -3,7 +3,6 @@
 #include <MatrixMarket_Tpetra.hpp>
 #include <Teuchos_TimeMonitor.hpp>
 #include <algorithm>
-#include <map>
 #include <chrono>
 
 #include "krylov.hpp"
@@ -65,11 +64,11 @@ void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type
 }
 
 void NewtonSystem::Impl::from_owned(const multivector_type& owned, NodeVectorField& field) const {
-  field.assign(space.impl().local_nodes.size(), Vec3::Zero());
+  field.assign(space.impl().local_count, Vec3::Zero());
   auto view = owned.getLocalViewHost(Tpetra::Access::ReadOnly);
   double* data = field.data()->data();
   for (std::size_t r = 0; r < 3 * space.impl().owned_count; ++r) data[r] = view(r, 0);
-  space.distribute(field);
+  space.import_ghosts(field);
 }
 
 NewtonSystem::NewtonSystem(const NodeSpace& space, const SolverConfiguration& config)
@@ -135,36 +134,25 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
   const auto matrix = impl_->hessian->matrix();
   if (matrix.is_null()) throw std::logic_error("gather_entries: the operator is matrix-free");
   const auto& A = *matrix;
-  const auto& s = impl_->space.impl();
   const auto& comm = impl_->space.comm();
-  // System node id → grid node id, for every node (ids exact in doubles below 2^53).
-  std::vector<double> pairs;
-  for (std::size_t i = 0; i < s.owned_count; ++i)
-    pairs.insert(pairs.end(), {double(s.local_system_ids[i]), double(s.local_nodes[i])});
-  std::map<long long, long long> grid_of;
-  const auto all_pairs = comm.all_gather(pairs);
-  for (std::size_t k = 0; k < all_pairs.size(); k += 2)
-    grid_of[static_cast<long long>(all_pairs[k])] = static_cast<long long>(all_pairs[k + 1]);
-  auto grid_dof = [&](long long system_dof) { return 3 * grid_of.at(system_dof / 3) + system_dof % 3; };
-
+  // Local row and column dofs to grid dofs 3·(grid node id) + d (exact in doubles below 2^53).
+  const auto& nodes = impl_->space.partition().nodes();
+  auto grid_dof = [&](std::size_t local_dof) { return 3 * nodes[local_dof / 3] + static_cast<long long>(local_dof % 3); };
   std::vector<double> local;  // (row, column, value) triplets
-  const auto row_map = A.getRowMap();
-  const auto col_map = A.getColMap();
   for (std::size_t r = 0; r < A.getNodeNumRows(); ++r) {
     typename crs_matrix_type::local_inds_host_view_type cols;
     typename crs_matrix_type::values_host_view_type vals;
     A.getLocalRowView(static_cast<local_ordinal_type>(r), cols, vals);
     for (std::size_t k = 0; k < cols.extent(0); ++k) {
-      local.push_back(static_cast<double>(row_map->getGlobalElement(r)));
-      local.push_back(static_cast<double>(col_map->getGlobalElement(cols(k))));
+      local.push_back(static_cast<double>(grid_dof(r)));
+      local.push_back(static_cast<double>(grid_dof(static_cast<std::size_t>(cols(k)))));
       local.push_back(vals(k));
     }
   }
   const auto all = comm.all_gather(local);
   std::vector<std::tuple<long long, long long, double>> entries;
   for (std::size_t k = 0; k + 2 < all.size(); k += 3)
-    entries.emplace_back(grid_dof(static_cast<long long>(all[k])), grid_dof(static_cast<long long>(all[k + 1])),
-                         all[k + 2]);
+    entries.emplace_back(static_cast<long long>(all[k]), static_cast<long long>(all[k + 1]), all[k + 2]);
   std::sort(entries.begin(), entries.end());
   return entries;
 }

@@ -181,7 +181,9 @@ void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
         summary.linear_iterations += newton.linear_solves[k].iterations;
       }
       summary.newton_iterations += newton.iterations;
+      summary.graph_builds += report.partition_rebuilt;
       if (newton.converged) {
+        summary.ghost_particle_steps += comm_.sum(static_cast<std::int64_t>(report.ghost_particles));
         summary.particles_deleted += comm_.sum(static_cast<std::int64_t>(report.particles_deleted));
         summary.particles_migrated += comm_.sum(static_cast<std::int64_t>(report.particles_sent));
         summary.shared_node_steps += comm_.sum(static_cast<std::int64_t>(report.shared_nodes));
@@ -216,7 +218,8 @@ std::string clock_text(double seconds) {
 }
 }  // namespace
 
-std::string Simulation::write_checkpoint() const {
+std::string Simulation::write_checkpoint() {
+  integrator_->reset_reuse();  // continue as a run restarted from this checkpoint starts
   io::RunState state{time_, step_, frame_, time_step_cap_, scene_.name, {}};
   if (const auto* boxes = dynamic_cast<const parallel::BoxDecomposition*>(decomposition_.get()))
     for (const auto& b : boxes->boxes())
@@ -281,7 +284,8 @@ RunSummary Simulation::run(std::ostream& log) {
     if (comm_.is_root())
       log << "frame " << std::setw(4) << frame << "/" << frames << "  t = " << std::setprecision(4) << std::fixed
           << time_ << " s  steps " << summary.steps << "  newton " << summary.newton_iterations << "  cg "
-          << summary.linear_iterations << "  retries " << summary.retries << "  wall " << clock_text(elapsed)
+          << summary.linear_iterations << "  graphs " << summary.graph_builds << "  retries " << summary.retries
+          << "  wall " << clock_text(elapsed)
           << "  eta " << clock_text(elapsed / done * (frames - frame)) << std::defaultfloat << std::endl;
   }
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -134,8 +134,10 @@ int run_study(const StudySettings& settings, const std::string& study_file, cons
       double wave_speed = 0.0;
       for (const auto& m : sim.materials()) wave_speed = std::max(wave_speed, m->wave_speed());
       auto& integrator = sim.integrator();
-      integrator.build_layout(sim.particles());
-      integrator.particles_to_grid(sim.particles());
+      double largest_step = 0.0;
+      for (double step : settings.time_steps) largest_step = std::max(largest_step, step);
+      integrator.prepare(sim.particles(), settings.time_step_unit == "elastic CFL" ? largest_step * sim.grid().dx / wave_speed
+                                                                               : largest_step);
       for (double step : settings.time_steps) {
         const bool cfl = settings.time_step_unit == "elastic CFL";
         const double dt = cfl ? step * sim.grid().dx / wave_speed : step;
@@ -144,7 +146,7 @@ int run_study(const StudySettings& settings, const std::string& study_file, cons
         row.problem = base.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
         row.resolution = h;
         NodeVectorField rhs;
-        if (comm.any(!objective->potential->gradient(objective->initial_guess, rhs))) {
+        if (!integrator.first_right_hand_side(*objective, rhs)) {
           // No Newton system here: every configuration gets a failed row.
           if (comm.is_root()) log << row.problem << " dx=" << h << ": infeasible initial guess, no system\n";
           for (const auto& config : configs) {
@@ -154,12 +156,9 @@ int run_study(const StudySettings& settings, const std::string& study_file, cons
           }
           continue;
         }
-        integrator.node_space().accumulate(rhs);
         const auto& layout = integrator.layout();
-        for (std::size_t i = 0; i < rhs.size(); ++i) {
-          if (settings.right_hand_side == "newton") {
-            rhs[i] = -rhs[i];
-          } else {
+        for (std::size_t i = 0; i < layout.owned_count; ++i) {
+          if (settings.right_hand_side != "newton") {
             std::mt19937_64 rng(static_cast<std::uint64_t>(layout.nodes[i]));
             std::uniform_real_distribution<double> u(-1.0, 1.0);
             rhs[i] = integrator.grid_mass()[i] * Vec3(u(rng), u(rng), u(rng));

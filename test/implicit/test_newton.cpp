@@ -22,8 +22,7 @@ TEST(Newton, ConvergesQuadraticallyNearTheSolution) {
   const parallel::Communicator comm(MPI_COMM_WORLD);
   simulation::Simulation sim(scene, testkit::jacobi_cg(1e-13), comm);
   auto& integrator = sim.integrator();
-  integrator.build_layout(sim.particles());
-  integrator.particles_to_grid(sim.particles());
+  integrator.prepare(sim.particles(), 0.02);
   const auto objective = integrator.build_objective(sim.particles(), 0.0, 0.02);
   NodeVectorField v = objective->initial_guess;
   const auto report = implicit::newton_solve(*objective->potential, integrator.node_space(),
