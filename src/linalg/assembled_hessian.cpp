@@ -4,7 +4,7 @@
 // column indices; no global-index insertion, sorting or communication) and kept while the
 // partition lives; each assembly only refills the values, at offsets found from the window
 // position of every node pair of a cell.
-#include <Teuchos_TimeMonitor.hpp>
+#include <stdexcept>
 #include <algorithm>
 
 #include "hessian_operator.hpp"
@@ -31,15 +31,11 @@ class AssembledHessian : public HessianOperator {
  public:
   explicit AssembledHessian(const NodeSpace& space) : space_(space) {}
 
-  bool update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
-    const bool rebuild = matrix_.is_null() || space_.version() != graph_version_;
-    if (rebuild) {
-      static const auto graph_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3f newton graph");
-      Teuchos::TimeMonitor timer(*graph_timer);
-      build_graph(potential.layout());
-    }
+  void build_pattern() override;
+  void update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
+    if (matrix_.is_null() || space_.version() != graph_version_)
+      throw std::logic_error("AssembledHessian: the graph was not built for the current node partition");
     fill(potential, v, project);
-    return rebuild;
   }
   Teuchos::RCP<const operator_type> op() const override { return matrix_; }
   Teuchos::RCP<crs_matrix_type> matrix() const override { return matrix_; }
@@ -49,15 +45,12 @@ class AssembledHessian : public HessianOperator {
     return d;
   }
   std::int64_t nonzeros() const override { return nonzeros_; }
-  int pattern_builds() const override { return graph_builds_; }
 
  private:
-  void build_graph(const grid::GridLayout& layout);
   void fill(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project);
 
   const NodeSpace& space_;
   std::uint64_t graph_version_ = 0;
-  int graph_builds_ = 0;
   std::int64_t nonzeros_ = 0;
   Teuchos::RCP<crs_matrix_type> matrix_;
   row_map_view row_offsets_;
@@ -66,7 +59,7 @@ class AssembledHessian : public HessianOperator {
   std::vector<std::size_t> diagonal_;  // offset of node i's diagonal block in its first row
 };
 
-void AssembledHessian::build_graph(const grid::GridLayout& layout) {
+void AssembledHessian::build_pattern() {
   const auto& s = space_.impl();
   const parallel::NodePartition& partition = space_.partition();
   const std::size_t owned = partition.owned_count();
@@ -99,8 +92,8 @@ void AssembledHessian::build_graph(const grid::GridLayout& layout) {
   nonzeros_ = space_.comm().sum(static_cast<std::int64_t>(entries));
 
   // Window position of stencil node b as seen from stencil node a.
-  const int width = grid::stencil_width(layout.order);
-  const int K = layout.nodes_per_cell();
+  const int width = grid::stencil_width(partition.order());
+  const int K = grid::stencil_size(partition.order());
   const int R = partition.window_radius(), W = 2 * R + 1;
   pair_positions_.resize(static_cast<std::size_t>(K) * K);
   for (int a = 0; a < K; ++a)
@@ -110,7 +103,6 @@ void AssembledHessian::build_graph(const grid::GridLayout& layout) {
       pair_positions_[a * K + b] = (dx + R) + W * ((dy + R) + W * (dz + R));
     }
   graph_version_ = space_.version();
-  ++graph_builds_;
 }
 
 void AssembledHessian::fill(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) {

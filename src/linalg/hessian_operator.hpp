@@ -15,8 +15,11 @@ namespace viscompm::linalg {
 class HessianOperator {
  public:
   virtual ~HessianOperator() = default;
-  /// Prepares H at grid velocities v (collective). Returns true if its sparsity pattern changed.
-  virtual bool update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) = 0;
+  /// Builds the sparsity pattern (and whatever else depends only on the node space) for the
+  /// NodeSpace's current partition (collective).
+  virtual void build_pattern() = 0;
+  /// Prepares H at grid velocities v on the current pattern (collective).
+  virtual void update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) = 0;
   virtual Teuchos::RCP<const operator_type> op() const = 0;
   /// The assembled matrix, or null when matrix-free.
   virtual Teuchos::RCP<crs_matrix_type> matrix() const = 0;
@@ -24,8 +27,6 @@ class HessianOperator {
   virtual Teuchos::RCP<const vector_type> diagonal() const = 0;
   /// Global number of entries of H's sparsity pattern (the assembled one, also when matrix-free).
   virtual std::int64_t nonzeros() const = 0;
-  /// How many times a sparsity pattern was built.
-  virtual int pattern_builds() const = 0;
 };
 
 std::unique_ptr<HessianOperator> make_assembled_hessian(const NodeSpace& space);

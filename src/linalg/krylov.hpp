@@ -32,13 +32,18 @@ std::unique_ptr<Preconditioner> make_preconditioner(const SolverConfiguration& c
 class KrylovSolver {
  public:
   explicit KrylovSolver(const SolverConfiguration& config);
-  /// Solves A x = b from x = 0. Failures (breakdown, no convergence) are reported, not thrown.
+  /// Solves A x = b from x = 0 to the relative residual `tolerance` (≤ 0: the configuration's).
+  /// Failures (breakdown, no convergence) are reported, not thrown.
   LinearSolveReport solve(const Teuchos::RCP<const operator_type>& A, const Teuchos::RCP<operator_type>& M,
-                          multivector_type& x, const multivector_type& b);
+                          multivector_type& x, const multivector_type& b, double tolerance = 0.0);
+  /// The configuration's relative tolerance.
+  double default_tolerance() const { return default_tolerance_; }
 
  private:
   SolverConfiguration config_;
   Teuchos::RCP<Belos::SolverManager<scalar_type, multivector_type, operator_type>> solver_;
+  double default_tolerance_ = 1e-8;
+  double current_tolerance_ = 1e-8;
 };
 
 }  // namespace viscompm::linalg

@@ -11,7 +11,10 @@ class MatrixFreeHessian : public HessianOperator {
  public:
   explicit MatrixFreeHessian(const NodeSpace& space) : space_(space), apply_(Teuchos::rcp(new Apply(*this))) {}
 
-  bool update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
+  void build_pattern() override {
+    x_column_ = Teuchos::rcp(new vector_type(space_.impl().column_dof_map));
+  }
+  void update(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
     potential_ = &potential;
     hessians_ = potential.particle_hessians(v, project);
     // Per particle, the weight gradients of its stencil nodes (reused by every product).
@@ -27,20 +30,12 @@ class MatrixFreeHessian : public HessianOperator {
     const double scale = massless_row_scale(potential, space_.comm());
     for (std::size_t i = 0; i < layout.owned_count; ++i)
       diagonal_mass_[i] = potential.mass()[i] > 0.0 ? potential.mass()[i] : scale;
-    const bool changed = space_.version() != space_version_;
-    if (changed) {
-      space_version_ = space_.version();
-      ++builds_;
-      x_column_ = Teuchos::rcp(new vector_type(space_.impl().column_dof_map));
-    }
     compute_diagonal();
-    return changed;
   }
   Teuchos::RCP<const operator_type> op() const override { return apply_; }
   Teuchos::RCP<crs_matrix_type> matrix() const override { return Teuchos::null; }
   Teuchos::RCP<const vector_type> diagonal() const override { return diagonal_; }
   std::int64_t nonzeros() const override { return -1; }
-  int pattern_builds() const override { return builds_; }
 
  private:
   class Apply : public operator_type {
@@ -70,8 +65,6 @@ class MatrixFreeHessian : public HessianOperator {
   mutable NodeVectorField x_nodes_, y_nodes_;
   Teuchos::RCP<vector_type> diagonal_;
   Teuchos::RCP<vector_type> x_column_;
-  std::uint64_t space_version_ = 0;
-  int builds_ = 0;
 };
 
 void MatrixFreeHessian::apply_column(const vector_type& x, vector_type& y, double alpha, double beta) const {

@@ -63,7 +63,8 @@ namespace {
 class FixedMatrix : public HessianOperator {
  public:
   explicit FixedMatrix(Teuchos::RCP<crs_matrix_type> A) : A_(std::move(A)) {}
-  bool update(const implicit::IncrementalPotential&, const NodeVectorField&, bool) override { return false; }
+  void build_pattern() override {}
+  void update(const implicit::IncrementalPotential&, const NodeVectorField&, bool) override {}
   Teuchos::RCP<const operator_type> op() const override { return A_; }
   Teuchos::RCP<crs_matrix_type> matrix() const override { return A_; }
   Teuchos::RCP<const vector_type> diagonal() const override {
@@ -72,7 +73,6 @@ class FixedMatrix : public HessianOperator {
     return d;
   }
   std::int64_t nonzeros() const override { return static_cast<std::int64_t>(A_->getGlobalNumEntries()); }
-  int pattern_builds() const override { return 1; }
 
  private:
   Teuchos::RCP<crs_matrix_type> A_;

@@ -117,6 +117,8 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
   settings.transfer.flip_ratio = scene.simulation.flip_ratio;
   settings.newton = scene.newton;
   settings.delete_outside_particles = scene.grid.outside_particles == "delete";
+  settings.padding.margin = scene.grid.padding_cells;
+  settings.padding.lookahead = scene.grid.padding_lookahead;
   integrator_ = std::make_unique<TimeIntegrator>(comm_, geometry_, order_, *decomposition_, settings, materials_,
                                                  boundary_, solver);
 }
@@ -177,10 +179,17 @@ void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
       const StepReport report = integrator_->step(particles_, time_, dt, dump_prefix);
       const auto& newton = report.newton;
       for (std::size_t k = 0; k < newton.linear_solves.size(); ++k) {
-        if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), newton.linear_solves[k]);
-        summary.linear_iterations += newton.linear_solves[k].iterations;
+        const auto& solve = newton.linear_solves[k];
+        if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), solve);
+        summary.linear_iterations += solve.iterations;
+        summary.operator_seconds += solve.operator_seconds;
+        summary.preconditioner_seconds += solve.setup_seconds;
+        summary.cg_seconds += solve.solve_seconds;
       }
       summary.newton_iterations += newton.iterations;
+      summary.assemblies += newton.assemblies;
+      summary.preconditioner_setups += newton.preconditioner_setups;
+      summary.line_search_seconds += newton.line_search_seconds;
       summary.graph_builds += report.partition_rebuilt;
       if (newton.converged) {
         summary.ghost_particle_steps += comm_.sum(static_cast<std::int64_t>(report.ghost_particles));

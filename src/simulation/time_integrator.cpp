@@ -24,7 +24,8 @@ TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::G
       materials_(materials),
       boundary_(boundary),
       space_(comm),
-      system_(space_, solver) {
+      system_(space_, solver),
+      newton_(settings.newton, system_, comm) {
   layout_.geometry = geometry;
   layout_.order = order;
 }
@@ -52,12 +53,12 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
   NodeVectorField v = objective->initial_guess;
   {
     Teuchos::TimeMonitor m(*newton_timer);
-    implicit::SystemObserver dump;
+    newton::SystemObserver dump;
     if (!dump_prefix.empty())
       dump = [&](int iteration, const linalg::NewtonSystem& system, const NodeVectorField& rhs) {
         if (iteration == 1) system.write_matrix_market(dump_prefix, rhs);
       };
-    report.newton = implicit::newton_solve(*objective->potential, space_, system_, settings_.newton, v, dump);
+    report.newton = newton_.solve(*objective->potential, v, dump);
   }
   drop_ghosts(particles);
   if (!report.newton.converged) return report;
@@ -128,6 +129,7 @@ bool TimeIntegrator::build_layout(particles::ParticleSet& particles, double dt) 
     partition_decomposition_ = decomposition_;
     ++partition_builds_;
     space_.update(*partition_);
+    system_.build_pattern();
     layout_.nodes = partition_->nodes();
     layout_.owned_count = partition_->owned_count();
   }

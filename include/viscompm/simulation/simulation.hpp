@@ -31,6 +31,12 @@ struct RunSummary {
   std::int64_t newton_iterations = 0;
   std::int64_t linear_iterations = 0;
   std::int64_t retries = 0;
+  std::int64_t assemblies = 0;             ///< Hessians assembled (or matrix-free pieces prepared)
+  std::int64_t preconditioner_setups = 0;
+  double operator_seconds = 0.0;           ///< in assembly (or the matrix-free set-up), all solves
+  double preconditioner_seconds = 0.0;     ///< in preconditioner set-up
+  double cg_seconds = 0.0;                 ///< in CG
+  double line_search_seconds = 0.0;
   std::int64_t graph_builds = 0;         ///< node partitions (and Hessian graphs) built, all steps
   std::int64_t ghost_particle_steps = 0;  ///< Σ over steps of the global count of ghost particles
   std::int64_t particles_deleted = 0;

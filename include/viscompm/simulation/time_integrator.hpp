@@ -8,7 +8,7 @@
 
 #include "viscompm/boundary/colliders.hpp"
 #include "viscompm/grid/grid_layout.hpp"
-#include "viscompm/implicit/newton.hpp"
+#include "viscompm/newton/newton_solver.hpp"
 #include "viscompm/linalg/newton_system.hpp"
 #include "viscompm/linalg/node_space.hpp"
 #include "viscompm/materials/material.hpp"
@@ -30,7 +30,7 @@ struct IntegratorSettings {
   PaddingSettings padding;
   bool delete_outside_particles = false;  ///< else clamp them to the last cell
   transfer::TransferSettings transfer;
-  implicit::NewtonSettings newton;
+  newton::NewtonSettings newton;
 };
 
 /// The objective of one step, built from the last p2g (valid until the next build_layout).
@@ -43,7 +43,7 @@ struct StepObjective {
 
 struct StepReport {
   double dt = 0.0;
-  implicit::NewtonReport newton;
+  newton::NewtonReport newton;
   bool partition_rebuilt = false;   ///< the node partition (and the Hessian's graph) was built anew
   std::size_t ghost_particles = 0;  ///< neighbours' particles copied here
   std::size_t particles_clamped = 0;
@@ -70,10 +70,14 @@ class TimeIntegrator {
   /// steps of `dt`), and appends the ghost particles to `particles` (drop_ghosts removes them).
   /// Returns true if the partition was rebuilt.
   bool build_layout(particles::ParticleSet& particles, double dt);
-  /// Drops what steps reuse (the node partition and with it the Hessian's graph), as a run
+  /// Drops what steps reuse (the node partition, the Hessian's graph, a kept Hessian and
+  /// preconditioner), as a run
   /// restarted at this point starts: called after each checkpoint, so that restarts continue bit
   /// for bit (the padding decides the vector lengths, and so the grouping of floating-point sums).
-  void reset_reuse() { partition_.reset(); }
+  void reset_reuse() {
+    partition_.reset();
+    newton_.forget();
+  }
   /// build_layout and particles_to_grid: what tests, benchmarks and the solver study need before
   /// build_objective.
   void prepare(particles::ParticleSet& particles, double dt) {
@@ -119,6 +123,7 @@ class TimeIntegrator {
   int partition_builds_ = 0;
   linalg::NodeSpace space_;
   linalg::NewtonSystem system_;
+  newton::NewtonSolver newton_;
   NodeScalarField mass_;
   NodeVectorField momentum_, v_old_;
 };
