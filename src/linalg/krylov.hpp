@@ -18,6 +18,11 @@ struct NearNullspace {
   Teuchos::RCP<multivector_type> rigid_body_modes;
 };
 
+/// The 6 rigid-body modes (translations, rotations e_a × x about the axes) on `dof_map`, 3 dofs
+/// per node in node order, from the owned nodes' coordinates (one row of x, y, z per node).
+Teuchos::RCP<multivector_type> rigid_body_modes(const multivector_type& coordinates,
+                                                const Teuchos::RCP<const map_type>& dof_map);
+
 class Preconditioner {
  public:
   virtual ~Preconditioner() = default;

@@ -38,21 +38,14 @@ void NewtonSystem::Impl::build_near_nullspace() {
   const auto& s = space.impl();
   const auto& partition = space.partition();
   modes.coordinates = Teuchos::rcp(new multivector_type(s.owned_node_map, 3));
-  modes.rigid_body_modes = Teuchos::rcp(new multivector_type(s.owned_dof_map, 6));
-  auto xyz = modes.coordinates->getLocalViewHost(Tpetra::Access::OverwriteAll);
-  auto rbm = modes.rigid_body_modes->getLocalViewHost(Tpetra::Access::OverwriteAll);
-  for (std::size_t i = 0; i < partition.owned_count(); ++i) {
-    const Vec3 x = partition.geometry().node_position(partition.nodes()[i]);
-    for (int d = 0; d < 3; ++d) xyz(i, d) = x[d];
-    for (int d = 0; d < 3; ++d) {
-      for (int m = 0; m < 6; ++m) rbm(3 * i + d, m) = 0.0;
-      rbm(3 * i + d, d) = 1.0;  // translations
+  {
+    auto xyz = modes.coordinates->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < partition.owned_count(); ++i) {
+      const Vec3 x = partition.geometry().node_position(partition.nodes()[i]);
+      for (int d = 0; d < 3; ++d) xyz(i, d) = x[d];
     }
-    // Rotations about the axes: e_a × x.
-    rbm(3 * i + 1, 3) = -x.z(); rbm(3 * i + 2, 3) = x.y();
-    rbm(3 * i + 0, 4) = x.z();  rbm(3 * i + 2, 4) = -x.x();
-    rbm(3 * i + 0, 5) = -x.y(); rbm(3 * i + 1, 5) = x.x();
   }
+  modes.rigid_body_modes = rigid_body_modes(*modes.coordinates, s.owned_dof_map);
 }
 
 void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
@@ -175,7 +168,7 @@ void NewtonSystem::write_matrix_market(const std::string& prefix, const NodeVect
   if (matrix.is_null()) throw std::logic_error("write_matrix_market: the operator is matrix-free");
   multivector_type b(m.space.impl().owned_dof_map, 1);
   m.to_owned(rhs, b);
-  write_contiguous_matrix_market(*matrix, b, prefix);
+  write_contiguous_matrix_market(*matrix, b, *m.modes.coordinates, prefix);
 }
 
 double NewtonSystem::time_apply(int repetitions) const {

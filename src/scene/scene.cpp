@@ -45,7 +45,7 @@ const ParameterTable<GridSettings>& GridSettings::table() {
               "times the mean particle count; 0 never")
         .integer(&G::wall_thickness, "Wall thickness", 2, Range::closed(1, 8),
                  "nodes closer than this many cells to a face are wall nodes")
-        .integer(&G::padding_cells, "Padding cells", 1, Range::closed(0, 16),
+        .integer(&G::padding_cells, "Padding cells", 0, Range::closed(0, 16),
                  "the linear system's nodes (and the Hessian's graph) reach this many cells beyond the occupied "
                  "ones; the graph is rebuilt when a particle leaves them")
         .real(&G::padding_lookahead, "Padding lookahead", 8.0, Range::closed(0.0, 1000.0),

@@ -42,7 +42,7 @@ struct GridSettings {
   int wall_thickness = 2;
   std::string outside_particles = "clamp";
   double rebalance_threshold = 1.25;
-  int padding_cells = 1;
+  int padding_cells = 0;
   double padding_lookahead = 8.0;
   static const ParameterTable<GridSettings>& table();
 };

@@ -20,7 +20,7 @@ namespace viscompm::simulation {
 
 /// How far the node partition (the Hessian's graph) reaches beyond the occupied cells.
 struct PaddingSettings {
-  int margin = 1;              ///< cells around every occupied cell
+  int margin = 0;              ///< cells around every occupied cell
   double lookahead = 8.0;      ///< and further along each particle's velocity: this many steps
   int max_padding = 8;         ///< cap on the velocity padding, in cells
 };
