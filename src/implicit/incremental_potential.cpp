@@ -94,6 +94,13 @@ void IncrementalPotential::element_hessians(
   }
 }
 
+bool IncrementalPotential::cell_is_free(std::size_t c) const {
+  const int* nodes = layout_.nodes_of_cell(c);
+  for (int k = 0; k < layout_.nodes_per_cell(); ++k)
+    if (!node_is_free_[nodes[k]]) return false;
+  return true;
+}
+
 Mat3 IncrementalPotential::constrained_block(const ElementHessian& element, std::size_t c, int a, int b) const {
   Mat3 B = element.block(a, b);
   if (a == b) B = 0.5 * (B + B.transpose());

@@ -125,16 +125,58 @@ void AssembledHessian::fill(const implicit::IncrementalPotential& potential, con
   };
   potential.element_hessians(v, project, [&](std::size_t c, const implicit::ElementHessian& element) {
     const int* nodes = layout.nodes_of_cell(c);
+    if (!potential.cell_is_free(c)) {
+      // Constrained nodes in the stencil: the blocks through P_i B P_j.
+      for (int a = 0; a < K; ++a)
+        for (int b = a; b < K; ++b) {
+          const bool row_a = nodes[a] < owned, row_b = nodes[b] < owned && b != a;
+          if (!row_a && !row_b) continue;
+          const Mat3 B = potential.constrained_block(element, c, a, b);
+          if (row_a) add_block(nodes[a], a, b, B);
+          if (row_b) add_block(nodes[b], b, a, B.transpose());
+        }
+      return;
+    }
+    // The common case: read the element's lanes directly into the rows of a and of b.
     for (int a = 0; a < K; ++a) {
       const int i = nodes[a];
       const bool row_a = i < owned;
-      for (int b = a; b < K; ++b) {
+      const double* e[3][3];
+      for (int sigma = 0; sigma < 3; ++sigma)
+        for (int tau = 0; tau < 3; ++tau) e[sigma][tau] = element.lanes(a, sigma, tau);
+      double* rows_a[3] = {nullptr, nullptr, nullptr};
+      const std::int16_t* slots_a = nullptr;
+      if (row_a) {
+        for (int sigma = 0; sigma < 3; ++sigma) rows_a[sigma] = values + row_offsets_(3 * i + sigma);
+        slots_a = partition.window_slots(i);
+      }
+      const int* positions_a = pair_positions_.data() + a * K;
+      // Diagonal block, symmetrised.
+      if (row_a) {
+        const std::size_t slot = 3 * static_cast<std::size_t>(slots_a[positions_a[a]]);
+        for (int sigma = 0; sigma < 3; ++sigma)
+          for (int tau = 0; tau < 3; ++tau) rows_a[sigma][slot + tau] += 0.5 * (e[sigma][tau][a] + e[tau][sigma][a]);
+      }
+      for (int b = a + 1; b < K; ++b) {
         const int j = nodes[b];
-        const bool row_b = j < owned && b != a;
-        if (!row_a && !row_b) continue;
-        const Mat3 B = potential.constrained_block(element, c, a, b);
-        if (row_a) add_block(i, a, b, B);
-        if (row_b) add_block(j, b, a, B.transpose());
+        if (row_a) {
+          const std::size_t slot = 3 * static_cast<std::size_t>(slots_a[positions_a[b]]);
+          for (int sigma = 0; sigma < 3; ++sigma) {
+            double* row = rows_a[sigma] + slot;
+            row[0] += e[sigma][0][b];
+            row[1] += e[sigma][1][b];
+            row[2] += e[sigma][2][b];
+          }
+        }
+        if (j < owned) {
+          const std::size_t slot = 3 * static_cast<std::size_t>(partition.window_slots(j)[pair_positions_[b * K + a]]);
+          for (int tau = 0; tau < 3; ++tau) {
+            double* row = values + row_offsets_(3 * j + tau) + slot;
+            row[0] += e[0][tau][b];
+            row[1] += e[1][tau][b];
+            row[2] += e[2][tau][b];
+          }
+        }
       }
     }
   });

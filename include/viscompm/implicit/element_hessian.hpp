@@ -28,6 +28,10 @@ class ElementHessian {
   }
   /// Block (i, j) as a 3×3 matrix, i ≤ j.
   Mat3 block(int i, int j) const;
+  /// The entries (i, σ, τ) for every j ≥ i: row 3σ + τ of node i's lanes (entry j at index j).
+  const double* lanes(int i, int sigma, int tau) const {
+    return element_.data() + (static_cast<std::size_t>(i) * 9 + 3 * sigma + tau) * lanes_;
+  }
 
  private:
   int nodes_;

@@ -59,6 +59,8 @@ class IncrementalPotential {
   /// Δt² ∂²Φ_p/∂vec(A)² of every particle, own and ghost (projected if `project`), in particle
   /// order: the pieces a matrix-free Hessian applies.
   std::vector<Mat9> particle_hessians(const NodeVectorField& v, bool project) const;
+  /// True if no stencil node of cell c has a constraint (its element blocks need no P_i).
+  bool cell_is_free(std::size_t c) const;
   /// True where node i (local index) has no constraint.
   bool is_free(std::size_t i) const { return node_is_free_[i] != 0; }
 
