@@ -24,9 +24,10 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
         .string(&S::preconditioner, "Preconditioner", "Ifpack2", {"none", "Jacobi", "Ifpack2", "MueLu"},
                 "none; Jacobi (exact diagonal of H, also matrix-free); Ifpack2 or MueLu (assembled only)")
         .string(&S::ifpack2_type, "Ifpack2 type", "RELAXATION", {}, "Ifpack2::Factory name (RELAXATION, CHEBYSHEV, ...)")
-        .string(&S::prolongation, "Prolongation", "algebraic", {"algebraic", "trilinear", "quadratic B-spline"},
+        .string(&S::prolongation, "Prolongation", "algebraic", {"algebraic", "trilinear", "quadratic B-spline", "piecewise constant"},
                 "MueLu: the prolongators of its own aggregation (algebraic), or geometric ones between the grids "
-                "Δx, 2Δx, 4Δx, ... (trilinear, or the coarse quadratic B-spline at the fine nodes)")
+                "Δx, 2Δx, 4Δx, ... (trilinear, the coarse quadratic B-spline at the fine nodes, or piecewise "
+                "constant: 2×2×2-node aggregates, unsmoothed)")
         .integer(&S::coarsest_nodes, "Coarsest nodes", 2000, Range::at_least(1),
                  "geometric prolongation: coarsen until a level has at most this many nodes")
         .string(&S::near_nullspace, "Near nullspace", "rigid body modes", {"rigid body modes", "translations"},

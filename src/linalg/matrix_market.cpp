@@ -3,12 +3,16 @@
 #include <MatrixMarket_Tpetra.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <chrono>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 
 #include "krylov.hpp"
 #include "matrix_market_io.hpp"
 #include "viscompm/core/error.hpp"
+#include "viscompm/parallel/decomposition.hpp"
 
 namespace viscompm::linalg {
 
@@ -95,6 +99,46 @@ class FixedMatrix : public HessianOperator {
 };
 }  // namespace
 
+namespace {
+// The lattice behind node coordinates (a dump of an MPM grid): spacing = the smallest distance
+// between distinct coordinates, origin = the smallest coordinate, per axis; coarse levels of a
+// geometric hierarchy are owned in blocks of that lattice.
+std::shared_ptr<const SystemGrid> grid_from_coordinates(const multivector_type& coordinates,
+                                                        const parallel::Communicator& comm) {
+  auto xyz = coordinates.getLocalViewHost(Tpetra::Access::ReadOnly);
+  const std::size_t n = coordinates.getLocalLength();
+  Vec3 lowest = Vec3::Constant(std::numeric_limits<double>::infinity());
+  double spacing = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < 3; ++d) {
+    std::vector<double> values(n);
+    for (std::size_t i = 0; i < n; ++i) values[i] = xyz(i, d);
+    std::sort(values.begin(), values.end());
+    for (std::size_t i = 0; i < n; ++i) {
+      lowest[d] = std::min(lowest[d], values[i]);
+      if (i > 0 && values[i] - values[i - 1] > 1e-9 * std::abs(values[i])) spacing = std::min(spacing, values[i] - values[i - 1]);
+    }
+    lowest[d] = comm.min(lowest[d]);
+  }
+  spacing = comm.min(spacing);
+  if (!std::isfinite(spacing)) throw InputError("node coordinates: fewer than two distinct positions");
+  auto grid = std::make_shared<SystemGrid>();
+  Int3 highest = Int3::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Int3 ijk(static_cast<int>(std::lround((xyz(i, 0) - lowest.x()) / spacing)),
+                   static_cast<int>(std::lround((xyz(i, 1) - lowest.y()) / spacing)),
+                   static_cast<int>(std::lround((xyz(i, 2) - lowest.z()) / spacing)));
+    grid->owned_nodes.push_back(ijk);
+    highest = highest.cwiseMax(ijk);
+  }
+  for (int d = 0; d < 3; ++d) grid->dimensions[d] = static_cast<int>(comm.max(std::int64_t(highest[d]))) + 1;
+  grid::GridGeometry lattice;
+  lattice.cells = grid->dimensions - Int3::Ones();
+  auto blocks = std::make_shared<parallel::BlockDecomposition>(lattice, comm.size());
+  grid->owner = [blocks](const Int3& ijk) { return blocks->owner_of_node(ijk); };
+  return grid;
+}
+}  // namespace
+
 struct MatrixMarketProblem::Impl {
   Teuchos::RCP<crs_matrix_type> A;
   Teuchos::RCP<multivector_type> b;
@@ -131,6 +175,7 @@ MatrixMarketProblem::MatrixMarketProblem(const std::string& matrix_file, const p
     if (impl_->modes.coordinates->getNumVectors() != 3)
       throw InputError(coordinates_file + ": expected 3 columns (x, y, z)");
     impl_->modes.rigid_body_modes = rigid_body_modes(*impl_->modes.coordinates, dof_map);
+    impl_->modes.grid = grid_from_coordinates(*impl_->modes.coordinates, comm);
   }
   impl_->A = A;
   impl_->b = Teuchos::rcp(new multivector_type(A->getRangeMap(), 1));

@@ -191,8 +191,10 @@ class MueLuPreconditioner : public Preconditioner {
     const auto comm = A->getRowMap()->getComm();
     const parallel::Communicator communicator(*Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm)->getRawMpiComm());
     parallel::HierarchySettings settings;
-    settings.prolongation = config_.impl().settings.prolongation == "trilinear" ? parallel::Prolongation::trilinear
-                                                                                 : parallel::Prolongation::quadratic_bspline;
+    const std::string& kind = config_.impl().settings.prolongation;
+    settings.prolongation = kind == "trilinear"            ? parallel::Prolongation::trilinear
+                            : kind == "piecewise constant" ? parallel::Prolongation::piecewise_constant
+                                                           : parallel::Prolongation::quadratic_bspline;
     settings.max_levels = params.get<int>("max levels", 10);
     settings.coarsest_nodes = config_.impl().settings.coarsest_nodes;
     const auto levels = parallel::build_grid_hierarchy(communicator, modes.grid->dimensions, modes.grid->owned_nodes,

@@ -16,7 +16,9 @@ struct Parent {
 int axis_parents(Prolongation kind, int x, int shift, Parent* out) {
   int n = 0;
   auto add = [&](int index, double weight) { out[n++] = {index + shift, weight}; };
-  if (x % 2 == 0) {
+  if (kind == Prolongation::piecewise_constant) {
+    add(x / 2, 1.0);
+  } else if (x % 2 == 0) {
     if (kind == Prolongation::trilinear) {
       add(x / 2, 1.0);
     } else {
@@ -46,7 +48,7 @@ CoarseLevel coarsen(const Communicator& comm, const Int3& fine_dims, int fine_or
                     int level, const Int3& level0_last, const std::function<int(const Int3&)>& owner,
                     Prolongation kind) {
   CoarseLevel c;
-  const int shift = kind == Prolongation::trilinear ? 0 : 1;
+  const int shift = kind == Prolongation::quadratic_bspline ? 1 : 0;
   c.spacing = 1 << level;
   c.origin = fine_origin - shift * c.spacing;
   c.dimensions = fine_dims.unaryExpr([shift](int n) { return n / 2 + 1 + 2 * shift; });

@@ -5,8 +5,10 @@
 //   trilinear:            a fine node at an even index copies its coarse node, one at an odd
 //                         index averages its two neighbours (weights 1 | ½ ½);
 //   quadratic B-spline:   the coarse quadratic B-spline N(d/2) evaluated at the fine nodes
-//                         (weights ⅛ ¾ ⅛ at even indices | ½ ½ at odd ones).
-// Both reproduce linear fields; a 3D weight is the product of the axes'. A coarse level holds the
+//                         (weights ⅛ ¾ ⅛ at even indices | ½ ½ at odd ones);
+//   piecewise constant:   fine nodes 2k and 2k + 1 copy coarse node k (aggregates of 2×2×2
+//                         nodes with unsmoothed prolongation: brick aggregation, made geometric).
+// The first two reproduce linear fields, the third constants only; a 3D weight is the product of the axes'. A coarse level holds the
 // coarse nodes some finer node interpolates from; each is owned by the rank that owns its level-0
 // position (clamped to the grid: its fine twin), so levels follow the fine ownership. Built from local arrays with
 // a few personalised exchanges (collective); rank-independent. Trilinos-free: linalg turns the
@@ -22,7 +24,7 @@
 
 namespace viscompm::parallel {
 
-enum class Prolongation { trilinear, quadratic_bspline };
+enum class Prolongation { trilinear, quadratic_bspline, piecewise_constant };
 
 /// One coarse level and the prolongation from the level below it.
 struct CoarseLevel {
