@@ -441,7 +441,8 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   read_emitters_and_regions(*root, file, scene);
 
   // Cross-parameter checks.
-  if (scene.bodies.empty()) throw InputError(file + ": parameter 'Bodies': the scene has no bodies");
+  if (scene.bodies.empty() && scene.emitters.empty())
+    throw InputError(file + ": parameter 'Bodies': the scene has no bodies (and no emitters)");
   if (!(scene.grid.upper_corner.array() > scene.grid.lower_corner.array()).all())
     throw InputError(file + ": parameter 'Grid/Upper corner': must exceed Lower corner in every component");
   const Vec3 extent = scene.grid.upper_corner - scene.grid.lower_corner;
