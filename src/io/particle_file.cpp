@@ -264,7 +264,7 @@ particles::ParticleSet read_particle_file(const std::string& path, const paralle
   if (file < 0) throw InputError(path + ": not a readable HDF5 file");
   H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_attribute, &attributes);
   // Small root arrays: every rank reads all of each.
-  for (const char* name : {"decomposition_boxes"}) {
+  for (const char* name : {"decomposition_boxes", "emitter_layers"}) {
     if (H5Lexists(file, name, H5P_DEFAULT) <= 0) continue;
     const hid_t dataset = H5Dopen2(file, name, H5P_DEFAULT);
     const hid_t space = H5Dget_space(dataset);
