@@ -7,7 +7,7 @@
 # packages) when they are missing.
 #
 # Usage: scripts/render.sh OUTPUT_DIR [--field NAME] [--size WxH] [--frames all|last|N,M,...]
-#                          [--range LO HI] [--view iso|x|y|z] [--fps N] [--no-movie]
+#                          [--range LO HI] [--view iso|x|y|z] [--clip x|y|z] [--fps N] [--no-movie]
 set -euo pipefail
 
 usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
@@ -23,7 +23,7 @@ while [ $# -gt 0 ]; do
     --fps) FPS="$2"; shift 2 ;;
     --no-movie) MOVIE=0; shift ;;
     --range) forward+=("$1" "$2" "$3"); shift 3 ;;
-    --field|--size|--frames|--view) forward+=("$1" "$2"); shift 2 ;;
+    --field|--size|--frames|--view|--clip) forward+=("$1" "$2"); shift 2 ;;
     *) echo "render.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

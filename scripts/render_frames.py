@@ -33,6 +33,9 @@ def parse():
     ap.add_argument("--range", nargs=2, type=float, metavar=("LO", "HI"),
                     help="colour range (default: det_b_elastic 1 ± its largest deviation in the rendered frames)")
     ap.add_argument("--view", default="iso", choices=["iso", "x", "y", "z"], help="camera direction (default iso)")
+    ap.add_argument("--clip", choices=["x", "y", "z"],
+                    help="show only the particles below the middle of the particles' first frame along this axis "
+                         "(a cut through the interior, e.g. the bullet's path in the sponge)")
     return ap.parse_args()
 
 
@@ -97,6 +100,16 @@ def main():
     out_dir = os.path.join(args.output_dir, "render")
     os.makedirs(out_dir, exist_ok=True)
 
+    axis = {"x": 0, "y": 1, "z": 2}.get(args.clip)
+    cut = None
+    if axis is not None:
+        with h5py.File(numbered[frames[0]], "r") as h5:
+            x = h5["particles/position"][...]
+            cut = 0.5 * (x[:, axis].min() + x[:, axis].max()) if len(x) else 0.0
+
+    def kept(x):
+        return np.ones(len(x), dtype=bool) if cut is None else x[:, axis] <= cut
+
     # One pass for the colour range, the particle size and the camera.
     lo_hi, bounds_lo, bounds_hi, volume = [math.inf, -math.inf], np.full(3, math.inf), np.full(3, -math.inf), []
     for f in frames:
@@ -104,8 +117,11 @@ def main():
             p = h5["particles"]
             if p["position"].shape[0] == 0:
                 continue
-            values = field_values(p, args.field)
             x = p["position"][...]
+            values = field_values(p, args.field)[kept(x)]
+            x = x[kept(x)]
+            if len(x) == 0:
+                continue
             bounds_lo, bounds_hi = np.minimum(bounds_lo, x.min(axis=0)), np.maximum(bounds_hi, x.max(axis=0))
             lo_hi = [min(lo_hi[0], values.min()), max(lo_hi[1], values.max())]
             volume.append(np.median(p["volume0"][...]))
@@ -144,7 +160,8 @@ def main():
     for f in frames:
         with h5py.File(numbered[f], "r") as h5:
             p = h5["particles"]
-            particles = producer(points_polydata(p["position"][...], field_values(p, args.field), args.field))
+            x = p["position"][...]
+            particles = producer(points_polydata(x[kept(x)], field_values(p, args.field)[kept(x)], args.field))
             shown = [particles]
             display = simple.Show(particles, view)
             display.SetRepresentationType("Point Gaussian")

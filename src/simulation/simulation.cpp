@@ -286,6 +286,11 @@ RunSummary Simulation::run(std::ostream& log) {
     log << scene_.name << ": " << particle_count << " particles, grid " << geometry_.cells.transpose() << " cells of "
         << geometry_.dx << " m, " << comm_.size() << " rank(s), " << frames << " frames"
         << (restarted_ ? ", restarted at frame " + std::to_string(frame_) : std::string()) << "\n";
+  for (const auto& e : emitters_)
+    if (comm_.is_root())
+      log << "  emitter " << e.spec().name << ": " << e.layer_size() << " particles per layer, "
+          << e.layer_size() / e.layer_interval() << " particles/s, "
+          << e.particle_mass() * e.layer_size() / e.layer_interval() << " kg/s\n";
   const int first = frame_ + 1;
   for (int frame = first; frame <= frames; ++frame) {
     advance_to(frame * frame_duration, summary, &log);
