@@ -10,6 +10,7 @@ import os
 import shlex
 import subprocess
 import sys
+import time
 import xml.etree.ElementTree as ET
 
 import h5py
@@ -22,7 +23,7 @@ SETTINGS = {
     "shaving_foam": ["Simulation/Frame rate=12"],                                # the stream falls
     "weissenberg_sweep": ["Grid/Cell size=0.05", "Simulation/Frame rate=10"],    # the balls land
     "viennetta": ["Simulation/Frame rate=6"],                                    # it reaches the belt
-    "pie": ["Simulation/Frame rate=20"],                                         # the pie hits the head
+    "pie": ["Grid/Cell size=0.04", "Simulation/Frame rate=240"],                 # the pie reaches the head
     "toothpaste": ["Simulation/Frame rate=3"],                                   # it reaches the brush
 }
 
@@ -52,7 +53,9 @@ def main():
                                                "--frames", "2"]
         for s in SETTINGS.get(name, []):
             command += ["--set", s]
+        started = time.time()
         result = subprocess.run(command, capture_output=True, text=True)
+        elapsed = time.time() - started
         check(result.returncode == 0, f"{name}: exit {result.returncode}: {result.stderr[-1500:]}")
         if result.returncode != 0:
             continue
@@ -94,7 +97,8 @@ def main():
             with h5py.File(os.path.join(out, file_name), "r") as f:
                 dims = tuple(int(d) for d in item.attrib["Dimensions"].split())
                 check(dataset in f and f[dataset].shape == dims, f"{name}: xdmf item {item.text} {dims}")
-        print(f"{name}: ok" if not any(m.startswith(name) for m in failures) else f"{name}: FAILED")
+        status = "ok" if not any(m.startswith(name) for m in failures) else "FAILED"
+        print(f"{name}: {status} ({elapsed:.1f} s)")
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)
