@@ -147,7 +147,7 @@ def main():
     direction = np.array({"iso": (0.7, 0.45, 1.0), "x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 1e-3), "z": (0.0, 0.0, 1.0)}[args.view])
     direction /= np.linalg.norm(direction)
     view.CameraFocalPoint = list(centre)
-    view.CameraPosition = list(centre + 2.6 * extent * direction)
+    view.CameraPosition = list(centre + 2.1 * extent * direction)
     view.CameraViewUp = [0.0, 0.0, 1.0] if args.view == "y" else [0.0, 1.0, 0.0]
     view.CameraViewAngle = 30
 

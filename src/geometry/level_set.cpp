@@ -80,9 +80,13 @@ TriangleMesh particle_surface(const std::vector<Vec3>& positions, double radius,
   }
   grid->setName("surface");
   if (!vdb_file.empty()) {
-    openvdb::io::File file(vdb_file);
-    file.write({grid});
-    file.close();
+    try {
+      openvdb::io::File file(vdb_file);
+      file.write({grid});
+      file.close();
+    } catch (const openvdb::Exception& e) {
+      throw SimulationError("cannot write " + vdb_file + " (" + e.what() + ")");
+    }
   }
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;

@@ -311,7 +311,10 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
         .integer(&OutputSettings::checkpoint_every, "Checkpoint every", 0, Range::at_least(0),
                  "write DIR/checkpoint_NNNNN.h5 every this many frames (0: never); --restart continues from one")
         .real_list(&OutputSettings::matrix_market_steps, "Matrix Market steps", {}, Range::at_least(1),
-                   "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx");
+                   "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx")
+        .real(&OutputSettings::surface_voxel_size, "Surface voxel size", 0.0, Range::non_negative(),
+              "> 0: write each frame's particle surface (OpenVDB level set of spheres of the particle spacing, "
+              "voxels of this size [m]) to DIR/surface_NNNNN.obj and DIR/surface_NNNNN.vdb; 0: none");
     return table;
   }();
   return t;

@@ -6,10 +6,12 @@
 #include <filesystem>
 #include <numeric>
 #include <iomanip>
+#include <sstream>
 #include <ostream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/io/checkpoint.hpp"
+#include "viscompm/geometry/level_set.hpp"
 #include "viscompm/io/collider_output.hpp"
 #include "viscompm/io/particle_file.hpp"
 #include "viscompm/materials/registry.hpp"
@@ -272,6 +274,7 @@ RunSummary Simulation::run(std::ostream& log) {
     frame_ = frame;
     frames_.push_back(io::write_frame(directory, {frame, time_, step_, 0}, particles_, materials_, comm_, frame_extras()));
     if (comm_.is_root()) io::write_xdmf(directory, frames_);
+    if (scene_.output.surface_voxel_size > 0.0) write_surface(frame);
     if (checkpoint_every > 0 && frame % checkpoint_every == 0) write_checkpoint();
   };
   if (restarted_) {
@@ -326,6 +329,26 @@ io::FrameExtras Simulation::frame_extras() const {
   io::add_collider_surfaces(boundary_, time_, geometry_.origin, geometry_.upper_corner(), extras);
   extras.emitted_mass = emitted_mass();
   return extras;
+}
+
+void Simulation::write_surface(int frame) const {
+  // The particles of all ranks on rank 0, as spheres of the particle spacing (h = V0^(1/3)).
+  std::vector<double> local;
+  double spacing = 0.0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    local.insert(local.end(), particles_.position[p].data(), particles_.position[p].data() + 3);
+    spacing = std::max(spacing, std::cbrt(particles_.volume0[p]));
+  }
+  const std::vector<double> all = comm_.all_gather(local);
+  spacing = comm_.max(spacing);
+  if (!comm_.is_root() || all.empty()) return;
+  std::vector<Vec3> positions(all.size() / 3);
+  for (std::size_t p = 0; p < positions.size(); ++p) positions[p] = Vec3(all[3 * p], all[3 * p + 1], all[3 * p + 2]);
+  std::ostringstream name;
+  name << scene_.output.directory << "/surface_" << std::setw(5) << std::setfill('0') << frame;
+  const geometry::TriangleMesh surface =
+      geometry::particle_surface(positions, spacing, scene_.output.surface_voxel_size, name.str() + ".vdb");
+  geometry::write_obj(surface, name.str() + ".obj");
 }
 
 }  // namespace viscompm::simulation

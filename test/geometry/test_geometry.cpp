@@ -194,3 +194,32 @@ TEST(SceneMeshes, BadMeshesAreOneLineErrorsNamingSceneParameterAndFile) {
   write_scene("closed.obj", "Bodies");
   EXPECT_EQ(message(), "no error");
 }
+
+TEST(ParticleSurface, EnclosesTheParticlesOfABallAndIsWrittenForRenderers) {
+  // Particles of a ball of radius 0.2 on a lattice of spacing h, as spheres of radius h.
+  const double R = 0.2, h = 0.01;
+  std::vector<Vec3> positions;
+  for (double x = -R; x <= R; x += h)
+    for (double y = -R; y <= R; y += h)
+      for (double z = -R; z <= R; z += h)
+        if (Vec3(x, y, z).norm() <= R) positions.emplace_back(x, y, z);
+  const std::string vdb = temp_path("ball_surface.vdb");
+  std::filesystem::remove(vdb);
+  const auto surface = geometry::particle_surface(positions, h, h / 2, vdb);
+  EXPECT_TRUE(std::filesystem::exists(vdb));
+  ASSERT_GT(surface.triangles.size(), 1000u);
+  const double volume = geometry::enclosed_volume(surface);  // positive: outward-facing triangles
+  EXPECT_GT(volume, 4.0 / 3.0 * M_PI * std::pow(R, 3));
+  EXPECT_LT(volume, 4.0 / 3.0 * M_PI * std::pow(R + 1.5 * h, 3));
+  // The surface lies one particle radius outside the outermost particles.
+  Vec3 lo, hi, particles_lo = Vec3::Constant(1.0), particles_hi = Vec3::Constant(-1.0);
+  surface.bounding_box(lo, hi);
+  for (const Vec3& x : positions) {
+    particles_lo = particles_lo.cwiseMin(x);
+    particles_hi = particles_hi.cwiseMax(x);
+  }
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_NEAR(hi[d], particles_hi[d] + h, 0.25 * h);
+    EXPECT_NEAR(lo[d], particles_lo[d] - h, 0.25 * h);
+  }
+}

@@ -20,7 +20,7 @@ import numpy as np
 SETTINGS = {
     "twisting_sponge": ["Grid/Cell size=0.3", "Simulation/Frame rate=8"],        # grips turn 0.19 rad
     "shooting_sponge": ["Simulation/Frame rate=30"],                             # the bullet hits
-    "shaving_foam": ["Simulation/Frame rate=12"],                                # the stream falls
+    "shaving_foam": ["Simulation/Frame rate=12", "Output/Surface voxel size=0.003"],  # the stream falls
     "weissenberg_sweep": ["Grid/Cell size=0.05", "Simulation/Frame rate=10"],    # the balls land
     "viennetta": ["Simulation/Frame rate=6"],                                    # it reaches the belt
     "pie": ["Grid/Cell size=0.04", "Simulation/Frame rate=240"],                 # the pie reaches the head
@@ -87,6 +87,17 @@ def main():
                     c = f["colliders"]
                     check(c["triangles"].shape[1] == 3 and c["triangles"][...].max() < c["vertices"].shape[0],
                           f"{name} frame {frame}: collider triangles index its vertices")
+        # Surfaces where asked for: an OBJ per frame that encloses volume, and the VDB level set.
+        if any(o.startswith("Output/Surface voxel size") for o in SETTINGS[name]):
+            for frame in range(3):
+                obj, vdb = (os.path.join(out, f"surface_{frame:05d}.{ext}") for ext in ("obj", "vdb"))
+                check(os.path.exists(obj) and os.path.exists(vdb), f"{name}: surface_{frame:05d}.obj and .vdb")
+                if os.path.exists(obj):
+                    lines = open(obj).read().split("\n")
+                    v = np.array([[float(t) for t in l.split()[1:]] for l in lines if l.startswith("v ")])
+                    f = np.array([[int(t) - 1 for t in l.split()[1:]] for l in lines if l.startswith("f ")])
+                    volume = np.sum(np.einsum("ij,ij->i", v[f[:, 0]], np.cross(v[f[:, 1]], v[f[:, 2]]))) / 6 if len(f) else 0
+                    check(volume > 0, f"{name}: surface_{frame:05d}.obj encloses volume ({volume})")
         # The XDMF index names datasets that exist, with the right shapes.
         xdmf = os.path.join(out, "particles.xdmf")
         collections = [g.attrib["Name"] for g in ET.parse(xdmf).getroot().findall("./Domain/Grid")]

@@ -116,6 +116,7 @@ struct OutputSettings {
   std::string directory = "output";
   RealList matrix_market_steps;  ///< steps whose first Newton system is written to MatrixMarket
   int checkpoint_every = 0;      ///< frames between checkpoints (0: none)
+  double surface_voxel_size = 0.0;  ///< > 0: each frame's particle surface (OpenVDB) as OBJ and VDB
   static const ParameterTable<OutputSettings>& table();
 };
 

@@ -78,6 +78,8 @@ class Simulation {
   double emitted_mass() const;
   /// What a frame written now holds besides the particles (collider surfaces, emitted mass).
   io::FrameExtras frame_extras() const;
+  /// Writes DIR/surface_NNNNN.{obj,vdb}: the particles' surface (Output/Surface voxel size).
+  void write_surface(int frame) const;
 
  private:
   scene::SceneConfig scene_;
