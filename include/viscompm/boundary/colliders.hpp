@@ -17,6 +17,7 @@
 #include "viscompm/boundary/rigid_motion.hpp"
 #include "viscompm/core/shape.hpp"
 #include "viscompm/grid/grid_layout.hpp"
+#include "viscompm/particles/particle_set.hpp"
 
 namespace viscompm::boundary {
 

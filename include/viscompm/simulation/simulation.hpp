@@ -32,6 +32,14 @@ struct RunSummary {
   std::int64_t newton_iterations = 0;
   std::int64_t linear_iterations = 0;
   std::int64_t retries = 0;
+  std::int64_t assemblies = 0;             ///< Hessians assembled (or matrix-free pieces prepared)
+  std::int64_t preconditioner_setups = 0;
+  double operator_seconds = 0.0;           ///< in assembly (or the matrix-free set-up), all solves
+  double preconditioner_seconds = 0.0;     ///< in preconditioner set-up
+  double cg_seconds = 0.0;                 ///< in CG
+  double line_search_seconds = 0.0;
+  std::int64_t graph_builds = 0;         ///< node partitions (and Hessian graphs) built, all steps
+  std::int64_t ghost_particle_steps = 0;  ///< Σ over steps of the global count of ghost particles
   std::int64_t particles_deleted = 0;
   std::int64_t particles_migrated = 0;  ///< sent between ranks, all steps
   std::int64_t shared_node_steps = 0;   ///< Σ over steps of the global count of ghost nodes
@@ -50,8 +58,9 @@ class Simulation {
   /// Writes frame 0 (unless restarted), then every remaining frame of the scene, with checkpoints
   /// as the scene asks, logging progress to `log` on rank 0.
   RunSummary run(std::ostream& log);
-  /// Writes DIR/checkpoint_NNNNN.h5 for the current frame; returns its path.
-  std::string write_checkpoint() const;
+  /// Writes DIR/checkpoint_NNNNN.h5 for the current frame; returns its path. The run then
+  /// continues as one restarted from it would (TimeIntegrator::reset_reuse).
+  std::string write_checkpoint();
   /// Advances to time t_end with adaptive steps (no output). Throws SimulationError if Newton
   /// fails at the smallest Δt.
   void advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr);
