@@ -12,6 +12,8 @@ packages=(
   trilinos-all-dev libptscotch-dev libscotch-dev   # Trilinos' CMake files name scotch by path
   libopenmpi-dev openmpi-bin
   libeigen3-dev libhdf5-openmpi-dev
+  libassimp-dev libopenvdb-dev libtbb-dev libboost-iostreams-dev   # meshes, level sets (geometry/)
+  paraview python3-paraview xvfb xauth ffmpeg                        # pictures: scripts/render.sh
   libgtest-dev
   python3 python3-numpy python3-h5py python3-matplotlib
 )

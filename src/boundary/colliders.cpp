@@ -1,6 +1,7 @@
 #include "viscompm/boundary/colliders.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "viscompm/core/error.hpp"
 
@@ -13,13 +14,34 @@ ContactType contact_type_from_name(const std::string& name) {
   throw InputError("unknown contact type '" + name + "' (expected sticky, slip or separating)");
 }
 
-Vec3 Collider::velocity_at(double t) const {
-  return (t >= start_time && t < stop_time) ? velocity : Vec3::Zero();
+double Collider::signed_distance(const Vec3& x, double t) const {
+  return shape.signed_distance(transform_at(t).inverse(x));
 }
 
-Shape Collider::shape_at(double t) const {
-  const double moving = std::clamp(t, start_time, stop_time) - start_time;
-  return shape.translated(moving * velocity);
+Vec3 Collider::normal(const Vec3& x, double t) const {
+  const RigidTransform T = transform_at(t);
+  return T.rotation * shape.normal(T.inverse(x));
+}
+
+Vec3 Collider::velocity_at(const Vec3& x, double t) const {
+  Vec3 u = motion.velocity_at(x, t);
+  if (surface_velocity.squaredNorm() > 0.0) {
+    const Vec3 n = normal(x, t);
+    const Vec3 s = transform_at(t).rotation * surface_velocity;
+    u += s - s.dot(n) * n;
+  }
+  return u;
+}
+
+double Collider::max_speed() const {
+  Vec3 lo, hi;
+  shape.bounding_box(lo, hi);
+  // Unbounded solids (half-spaces) only translate usefully; their rotation speed is not bounded.
+  const double reach = lo.allFinite() && hi.allFinite()
+                           ? std::max((lo - motion.center).cwiseAbs().maxCoeff(), (hi - motion.center).cwiseAbs().maxCoeff()) *
+                                 std::sqrt(3.0)
+                           : 0.0;
+  return motion.max_speed(reach) + surface_velocity.norm();
 }
 
 void NodeConstraints::apply(NodeVectorField& v) const {
@@ -74,8 +96,8 @@ NodeConstraints Boundary::constrain(const grid::GridLayout& layout, double t,
   NodeConstraints c;
   c.projection.assign(n, Mat3::Identity());
   c.prescribed.assign(n, Vec3::Zero());
-  std::vector<Shape> shapes;
-  for (const auto& col : colliders_) shapes.push_back(col.shape_at(t));
+  std::vector<RigidTransform> transforms;
+  for (const auto& col : colliders_) transforms.push_back(col.transform_at(t));
   const Int3 cells = layout.geometry.cells;
   // Nodes on a solid's surface count as inside (node positions carry rounding).
   const double surface_tolerance = 1e-9 * layout.geometry.dx;
@@ -90,10 +112,16 @@ NodeConstraints Boundary::constrain(const grid::GridLayout& layout, double t,
       if (inward[d] != 0.0) contacts.add(walls_.type, inward, Vec3::Zero(), v_trial[i]);
     }
     for (std::size_t k = 0; k < colliders_.size(); ++k) {
-      if (shapes[k].signed_distance(x) > surface_tolerance) continue;
-      // The solid pushes outward: its outward normal is the contact normal.
-      contacts.add(colliders_[k].type, shapes[k].normal(x), colliders_[k].velocity_at(t), v_trial[i]);
+      const Vec3 x_rest = transforms[k].inverse(x);
+      if (colliders_[k].shape.signed_distance(x_rest) > surface_tolerance) continue;
+      // The solid pushes outward: its outward normal is the contact normal; u = v₀ + ω × (x − c).
+      contacts.add(colliders_[k].type, transforms[k].rotation * colliders_[k].shape.normal(x_rest),
+                   colliders_[k].velocity_at(x, t), v_trial[i]);
     }
+    // Emitters: the nozzle's nodes move with the inflow velocity.
+    for (const Inflow& inflow : inflows_)
+      if (inflow.active(t) && inflow.nozzle.signed_distance(x) <= surface_tolerance)
+        contacts.add(ContactType::sticky, Vec3::UnitY(), inflow.velocity, v_trial[i]);
     if (!contacts.sticky && contacts.normals.empty()) continue;
     contacts.finish(c.projection[i], c.prescribed[i]);
     ++c.constrained_count;

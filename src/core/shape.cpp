@@ -13,6 +13,8 @@ Shape::Kind Shape::kind_from_name(const std::string& name) {
   if (name == "sphere") return Kind::sphere;
   if (name == "cylinder") return Kind::cylinder;
   if (name == "half_space") return Kind::half_space;
+  if (name == "mesh") return Kind::mesh;
+  if (name == "cuts") return Kind::cuts;
   throw InputError("unknown shape '" + name + "'");
 }
 
@@ -22,6 +24,8 @@ std::string Shape::kind_name(Kind kind) {
     case Kind::sphere: return "sphere";
     case Kind::cylinder: return "cylinder";
     case Kind::half_space: return "half_space";
+    case Kind::mesh: return "mesh";
+    case Kind::cuts: return "cuts";
   }
   return "?";
 }
@@ -31,6 +35,23 @@ Shape Shape::translated(const Vec3& offset) const {
   s.lower += offset;
   s.upper += offset;
   s.center += offset;
+  if (kind == Kind::mesh && offset != Vec3::Zero()) {
+    // A translated view of the same field.
+    struct Translated : DistanceField {
+      std::shared_ptr<const DistanceField> base;
+      Vec3 offset;
+      double signed_distance(const Vec3& x) const override { return base->signed_distance(x - offset); }
+      void bounding_box(Vec3& lo, Vec3& hi) const override {
+        base->bounding_box(lo, hi);
+        lo += offset;
+        hi += offset;
+      }
+    };
+    auto moved = std::make_shared<Translated>();
+    moved->base = field;
+    moved->offset = offset;
+    s.field = moved;
+  }
   return s;
 }
 
@@ -50,6 +71,19 @@ double Shape::signed_distance(const Vec3& x) const {
       return std::hypot(std::max(qa, 0.0), std::max(qb, 0.0)) + std::min(std::max(qa, qb), 0.0);
     }
     case Kind::half_space: return (x - center).dot(axis);
+    case Kind::mesh: return field ? field->signed_distance(x) : std::numeric_limits<double>::infinity();
+    case Kind::cuts: {
+      // Planes through the centre containing the axis, at angles k·π/count from a fixed normal.
+      const Vec3 r = x - center;
+      const Vec3 e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < cut_count; ++k) {
+        const double angle = M_PI * k / cut_count;
+        const Vec3 n = std::cos(angle) * e1 + std::sin(angle) * e2;
+        nearest = std::min(nearest, std::abs(r.dot(n)));
+      }
+      return nearest - 0.5 * cut_width;
+    }
   }
   return std::numeric_limits<double>::infinity();
 }
@@ -61,10 +95,13 @@ Vec3 Shape::normal(const Vec3& x) const {
     const double n = r.norm();
     return n > 0.0 ? Vec3(r / n) : Vec3::UnitY();
   }
-  // Central differences of the signed distance, scaled to the shape size.
+  // Central differences of the signed distance, scaled to the shape size (a mesh field: to its
+  // sampling, about a tenth of a voxel).
   Vec3 lo, hi;
   bounding_box(lo, hi);
-  const double h = 1e-6 * std::max((hi - lo).maxCoeff(), 1e-12);
+  const double h = kind == Kind::mesh ? 1e-3 * std::max((hi - lo).maxCoeff(), 1e-12)
+                   : kind == Kind::cuts ? 1e-6 * cut_width
+                                        : 1e-6 * std::max((hi - lo).maxCoeff(), 1e-12);
   Vec3 g;
   for (int d = 0; d < 3; ++d) {
     Vec3 e = Vec3::Zero();
@@ -87,6 +124,13 @@ void Shape::bounding_box(Vec3& lo, Vec3& hi) const {
       hi = center + half;
       return;
     }
+    case Kind::mesh:
+      if (field) {
+        field->bounding_box(lo, hi);
+        return;
+      }
+      [[fallthrough]];
+    case Kind::cuts:
     case Kind::half_space: {
       const double inf = std::numeric_limits<double>::infinity();
       lo = Vec3::Constant(-inf);

@@ -30,6 +30,7 @@ std::string write_checkpoint(const std::string& directory, const RunState& state
   attributes.integers["viscompm_checkpoint"] = format_version;
   attributes.strings["scene"] = state.scene;
   if (!state.decomposition_boxes.empty()) attributes.real_arrays["decomposition_boxes"] = state.decomposition_boxes;
+  if (!state.emitter_layers.empty()) attributes.real_arrays["emitter_layers"] = state.emitter_layers;
   const std::string path = (std::filesystem::path(directory) / checkpoint_file_name(state.frame)).string();
   write_particle_file(path, attributes, particles, {}, material_names(materials), comm);
   return path;
@@ -52,6 +53,7 @@ particles::ParticleSet read_checkpoint(const std::string& path, const parallel::
   names = attributes.strings.count("material_names") ? attributes.strings.at("material_names") : "";
   if (attributes.real_arrays.count("decomposition_boxes"))
     state.decomposition_boxes = attributes.real_arrays.at("decomposition_boxes");
+  if (attributes.real_arrays.count("emitter_layers")) state.emitter_layers = attributes.real_arrays.at("emitter_layers");
   return particles;
 }
 

@@ -20,7 +20,8 @@ std::string frame_file_name(int frame) {
 }
 
 FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
-                      const materials::MaterialList& materials, const parallel::Communicator& comm) {
+                      const materials::MaterialList& materials, const parallel::Communicator& comm,
+                      const FrameExtras& extras) {
   FileAttributes attributes;
   attributes.reals["time"] = info.time;
   attributes.integers["step"] = info.step;
@@ -29,8 +30,19 @@ FrameInfo write_frame(const std::string& directory, FrameInfo info, const partic
   const std::vector<DerivedTensor> derived = {{"left_cauchy_green_elastic", [&](std::size_t p) {
                                                  return materials[particles.material_id[p]]->left_cauchy_green_elastic(particles, p);
                                                }}};
+  std::vector<Table> tables;
+  if (!extras.collider_triangles.empty()) {
+    tables.push_back({"colliders/vertices", 3, extras.collider_vertices, {}});
+    tables.push_back({"colliders/triangles", 3, {}, extras.collider_triangles});
+    tables.push_back({"colliders/collider_id", 1, {}, extras.collider_id});
+    info.collider_vertices = static_cast<std::int64_t>(extras.collider_vertices.size() / 3);
+    info.collider_triangles = static_cast<std::int64_t>(extras.collider_triangles.size() / 3);
+    attributes.integers["collider_vertex_count"] = info.collider_vertices;
+    attributes.integers["collider_triangle_count"] = info.collider_triangles;
+  }
+  attributes.reals["emitted_mass"] = extras.emitted_mass;
   info.particle_count = write_particle_file((std::filesystem::path(directory) / frame_file_name(info.frame)).string(),
-                                            attributes, particles, derived, material_names(materials), comm);
+                                            attributes, particles, derived, material_names(materials), comm, tables);
   return info;
 }
 
@@ -79,7 +91,32 @@ void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& fram
       attribute("left_cauchy_green_elastic", "Tensor", "left_cauchy_green_elastic", n33, "Float", 8);
       out << "   </Grid>\n";
     }
-    out << "  </Grid>\n </Domain>\n</Xdmf>\n";
+    out << "  </Grid>\n";
+    // The colliders' surfaces, frame by frame (a second collection: ParaView shows both).
+    bool any_colliders = false;
+    for (const auto& f : frames) any_colliders |= f.collider_triangles > 0;
+    if (any_colliders) {
+      out << "  <Grid Name=\"colliders\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+      for (const auto& f : frames) {
+        if (f.collider_triangles == 0) continue;
+        const std::string file = frame_file_name(f.frame);
+        const std::string nv = std::to_string(f.collider_vertices), nt = std::to_string(f.collider_triangles);
+        out << "   <Grid Name=\"colliders_" << f.frame << "\" GridType=\"Uniform\">\n"
+            << "    <Time Value=\"" << std::setprecision(17) << f.time << "\"/>\n"
+            << "    <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << nt << "\">"
+            << "<DataItem Dimensions=\"" << nt << " 3\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << file
+            << ":/colliders/triangles</DataItem></Topology>\n"
+            << "    <Geometry GeometryType=\"XYZ\"><DataItem Dimensions=\"" << nv
+            << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file
+            << ":/colliders/vertices</DataItem></Geometry>\n"
+            << "    <Attribute Name=\"collider_id\" AttributeType=\"Scalar\" Center=\"Cell\"><DataItem Dimensions=\"" << nt
+            << " 1\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << file
+            << ":/colliders/collider_id</DataItem></Attribute>\n"
+            << "   </Grid>\n";
+      }
+      out << "  </Grid>\n";
+    }
+    out << " </Domain>\n</Xdmf>\n";
   }
   std::filesystem::rename(temporary, path);
 }

@@ -174,7 +174,8 @@ herr_t collect_attribute(hid_t location, const char* name, const H5A_info_t*, vo
 
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
-                                 const std::string& material_names, const parallel::Communicator& comm) {
+                                 const std::string& material_names, const parallel::Communicator& comm,
+                                 const std::vector<Table>& tables) {
   const std::string temporary = path + ".tmp";
   const auto n_local = static_cast<long long>(particles.size());
   long long offset = 0, n_total = 0;
@@ -206,6 +207,25 @@ std::int64_t write_particle_file(const std::string& path, const FileAttributes& 
   }
   write_string_attribute(group, "material_names", material_names);
   H5Gclose(group);
+  for (const Table& table : tables) {
+    // Collective creation, rows from rank 0.
+    const auto slash = table.path.rfind('/');
+    hid_t parent = file;
+    if (slash != std::string::npos) {
+      const std::string group_name = table.path.substr(0, slash);
+      parent = H5Lexists(file, group_name.c_str(), H5P_DEFAULT) > 0
+                   ? H5Gopen2(file, group_name.c_str(), H5P_DEFAULT)
+                   : H5Gcreate2(file, group_name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    }
+    const std::string name = slash == std::string::npos ? table.path : table.path.substr(slash + 1);
+    const std::size_t size = table.integers.empty() ? table.reals.size() : table.integers.size();
+    const hsize_t rows_total = size / table.columns, rows_here = comm.is_root() ? rows_total : 0;
+    if (table.integers.empty())
+      write_rows(parent, name, H5T_NATIVE_DOUBLE, table.reals, {table.columns}, rows_here, 0, rows_total);
+    else
+      write_rows(parent, name, H5T_NATIVE_INT64, table.integers, {table.columns}, rows_here, 0, rows_total);
+    if (parent != file) H5Gclose(parent);
+  }
   check(H5Fclose(file), "close " + temporary);
   comm.barrier();
   if (comm.is_root()) std::filesystem::rename(temporary, path);
@@ -244,7 +264,7 @@ particles::ParticleSet read_particle_file(const std::string& path, const paralle
   if (file < 0) throw InputError(path + ": not a readable HDF5 file");
   H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_attribute, &attributes);
   // Small root arrays: every rank reads all of each.
-  for (const char* name : {"decomposition_boxes"}) {
+  for (const char* name : {"decomposition_boxes", "emitter_layers"}) {
     if (H5Lexists(file, name, H5P_DEFAULT) <= 0) continue;
     const hid_t dataset = H5Dopen2(file, name, H5P_DEFAULT);
     const hid_t space = H5Dget_space(dataset);

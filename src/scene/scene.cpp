@@ -1,11 +1,13 @@
 #include "viscompm/scene/scene.hpp"
 
 #include <Teuchos_ParameterList.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/core/shape.hpp"
+#include "viscompm/geometry/level_set.hpp"
 #include "viscompm/materials/registry.hpp"
 #include "viscompm/scene/parameter_io.hpp"
 
@@ -58,8 +60,11 @@ const ParameterTable<GridSettings>& GridSettings::table() {
 
 namespace {
 template <class S>
-void add_shape_parameters(ParameterTable<S>& table) {
-  table.string(&S::shape, "Shape", "box", {"box", "sphere", "cylinder", "half_space"}, "solid shape")
+void add_shape_parameters(ParameterTable<S>& table,
+                          std::vector<std::string> shapes = {"box", "sphere", "cylinder", "half_space", "mesh"}) {
+  const bool mesh = std::find(shapes.begin(), shapes.end(), "mesh") != shapes.end();
+  const bool cuts = std::find(shapes.begin(), shapes.end(), "cuts") != shapes.end();
+  table.string(&S::shape, "Shape", shapes.front(), shapes, "solid shape")
       .vector3(&S::lower_corner, "Lower corner", Vec3::Zero(), "box: lower corner [m]")
       .vector3(&S::upper_corner, "Upper corner", Vec3::Ones(), "box: upper corner [m]")
       .vector3(&S::center, "Center", Vec3::Zero(), "sphere, cylinder: centre; half_space: a point on its plane [m]")
@@ -67,6 +72,15 @@ void add_shape_parameters(ParameterTable<S>& table) {
       .vector3(&S::axis, "Axis", Vec3::UnitY(), "cylinder: axis direction")
       .real(&S::length, "Length", 1.0, Range::positive(), "cylinder: length along its axis [m]")
       .vector3(&S::normal, "Normal", Vec3::UnitY(), "half_space: outward normal (the solid is below the plane)");
+  if (mesh)
+    table.string(&S::mesh_file, "File", "", {}, "mesh: OBJ or STL file (ASCII or binary), relative to the scene file")
+        .real(&S::mesh_scale, "Scale", 1.0, Range::positive(), "mesh: its vertices x are placed at Scale·x + Center")
+        .real(&S::voxel_size, "Voxel size", 0.0, Range::non_negative(),
+              "mesh: voxel of its signed distance field [m] (0: a quarter of Grid/Cell size)");
+  if (cuts)
+    table.integer(&S::cut_count, "Cut count", 4, Range::closed(1, 64),
+                  "cuts: planes through Center containing Axis, 180°/count apart (2·count slices)")
+        .real(&S::cut_width, "Cut width", 0.01, Range::positive(), "cuts: thickness of each cut [m]");
 }
 
 Shape make_shape(const ShapeSettings& s, const std::string& file, const std::string& path) {
@@ -77,6 +91,11 @@ Shape make_shape(const ShapeSettings& s, const std::string& file, const std::str
   shape.center = s.center;
   shape.radius = s.radius;
   shape.length = s.length;
+  shape.field = s.field;
+  shape.cut_count = s.cut_count;
+  shape.cut_width = s.cut_width;
+  if (shape.kind == Shape::Kind::mesh && !shape.field && !file.empty())
+    throw InputError(file + ": parameter '" + path + "/File': no mesh loaded");
   const Vec3 direction = shape.kind == Shape::Kind::half_space ? s.normal : s.axis;
   if (direction.norm() == 0.0) throw InputError(file + ": parameter '" + path + "': direction must be non-zero");
   shape.axis = direction.normalized();
@@ -85,7 +104,29 @@ Shape make_shape(const ShapeSettings& s, const std::string& file, const std::str
   return shape;
 }
 
-constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver", "Output", "Materials", "Bodies", "Colliders"};
+constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver", "Output", "Materials", "Bodies", "Colliders", "Emitters", "Regions"};
+
+// Reads the mesh of a mesh shape, places it (Scale, Center) and builds its signed distance field;
+// a body or region needs a closed mesh (it has an inside).
+void load_mesh(ShapeSettings& s, const std::string& file, const std::string& path, double cell_size,
+               bool must_be_closed) {
+  if (s.shape != "mesh") return;
+  const std::string where = file + ": parameter '" + path + "/File': ";
+  if (s.mesh_file.empty()) throw InputError(where + "a mesh shape needs a file");
+  const std::filesystem::path mesh_path = std::filesystem::path(s.mesh_file).is_absolute()
+                                              ? std::filesystem::path(s.mesh_file)
+                                              : std::filesystem::path(file).parent_path() / s.mesh_file;
+  geometry::TriangleMesh mesh;
+  try {
+    mesh = geometry::transformed(geometry::read_mesh(mesh_path.lexically_normal().string()), s.mesh_scale, s.center);
+  } catch (const InputError& e) {
+    throw InputError(where + e.what());
+  }
+  if (must_be_closed && !geometry::is_closed(mesh))
+    throw InputError(where + mesh_path.lexically_normal().string() +
+                     ": the mesh is not closed (every edge must join two consistently oriented triangles)");
+  s.field = std::make_shared<geometry::LevelSet>(mesh, s.voxel_size > 0.0 ? s.voxel_size : 0.25 * cell_size);
+}
 
 const std::vector<ParameterSpec>* fixed_section_specs(const std::string& section) {
   if (section == "Simulation") return &SimulationSettings::table().specs();
@@ -95,6 +136,8 @@ const std::vector<ParameterSpec>* fixed_section_specs(const std::string& section
   if (section == "Output") return &OutputSettings::table().specs();
   if (section == "Bodies") return &BodySettings::table().specs();
   if (section == "Colliders") return &ColliderSettings::table().specs();
+  if (section == "Emitters") return &EmitterSettings::table().specs();
+  if (section == "Regions") return &RegionSettings::table().specs();
   return nullptr;
 }
 
@@ -133,7 +176,7 @@ const ParameterSpec* find_spec(const Teuchos::ParameterList& list, const std::ve
       if (const auto* entry = materials::find_model(*model))
         storage.insert(storage.end(), entry->parameters.begin(), entry->parameters.end());
     specs = &storage;
-  } else if (section == "Bodies" || section == "Colliders") {
+  } else if (section == "Bodies" || section == "Colliders" || section == "Emitters" || section == "Regions") {
     if (parts.size() != 3) return nullptr;
     specs = fixed_section_specs(section);
   } else {
@@ -206,7 +249,51 @@ const ParameterTable<ColliderSettings>& ColliderSettings::table() {
                  "sticky: nodes inside move with the solid (Dirichlet grips); slip: normal only; separating: slip while approaching")
         .vector3(&C::velocity, "Velocity", Vec3::Zero(), "kinematic velocity [m/s]")
         .real(&C::start_time, "Start time", 0.0, Range::non_negative(), "time the solid starts moving [s]")
-        .real(&C::stop_time, "Stop time", 1e30, Range::non_negative(), "time the solid stops moving [s]");
+        .real(&C::stop_time, "Stop time", 1e30, Range::non_negative(), "time the solid stops moving [s]")
+        .vector3(&C::angular_velocity, "Angular velocity", Vec3::Zero(),
+                 "rotation rate ω about an axis through Rotation center [rad/s]: nodes move with v = Velocity + ω × (x − c)")
+        .vector3(&C::rotation_center, "Rotation center", Vec3::Zero(),
+                 "c: a point on the rotation axis at Start time (it moves with Velocity) [m]")
+        .real_list(&C::keyframe_times, "Keyframe times", {}, Range::non_negative(),
+                   "times of keyframes [s], increasing; if given they replace Velocity, Angular velocity and the times")
+        .real_list(&C::keyframe_positions, "Keyframe positions", {}, Range::any(),
+                   "translation of the solid at each keyframe, 3 numbers per keyframe [m] (linear in between)")
+        .real_list(&C::keyframe_rotations, "Keyframe rotations", {}, Range::any(),
+                   "rotation vector (axis·angle) about Rotation center at each keyframe, 3 numbers per keyframe [rad] "
+                   "(constant angular velocity in between); empty: no rotation")
+        .vector3(&C::surface_velocity, "Surface velocity", Vec3::Zero(),
+                 "velocity of the solid's surface, tangential part only (a conveyor belt that stays in place) [m/s]");
+    return table;
+  }();
+  return t;
+}
+
+const ParameterTable<EmitterSettings>& EmitterSettings::table() {
+  static const ParameterTable<EmitterSettings> t = [] {
+    ParameterTable<EmitterSettings> table;
+    using E = EmitterSettings;
+    add_shape_parameters(table, {"disc", "box", "cylinder"});
+    table.string(&E::material, "Material", "", {}, "name of a sublist of Materials")
+        .vector3(&E::velocity, "Velocity", Vec3::UnitX(),
+                 "inflow velocity [m/s]: emitted particles and the nozzle's grid nodes move with it (disc: its normal)")
+        .real(&E::mass_rate, "Mass rate", 0.0, Range::non_negative(),
+              "emitted mass per second [kg/s]; 0: a continuous stream, density · nozzle area · speed")
+        .real(&E::start_time, "Start time", 0.0, Range::non_negative(), "time the emission starts [s]")
+        .real(&E::stop_time, "Stop time", 1e30, Range::non_negative(), "time the emission stops [s]")
+        .integer(&E::particles_per_cell, "Particles per cell", 2, Range::closed(1, 8),
+                 "particles per cell and dimension in each emitted layer");
+    return table;
+  }();
+  return t;
+}
+
+const ParameterTable<RegionSettings>& RegionSettings::table() {
+  static const ParameterTable<RegionSettings> t = [] {
+    ParameterTable<RegionSettings> table;
+    using R = RegionSettings;
+    add_shape_parameters(table, {"box", "sphere", "cylinder", "mesh", "cuts"});
+    table.string(&R::body, "Body", "", {}, "name of a sublist of Bodies whose particles the region re-assigns")
+        .string(&R::material, "Material", "", {}, "name of a sublist of Materials: the particles' new material");
     return table;
   }();
   return t;
@@ -230,7 +317,10 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
         .integer(&OutputSettings::checkpoint_every, "Checkpoint every", 0, Range::at_least(0),
                  "write DIR/checkpoint_NNNNN.h5 every this many frames (0: never); --restart continues from one")
         .real_list(&OutputSettings::matrix_market_steps, "Matrix Market steps", {}, Range::at_least(1),
-                   "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx");
+                   "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx")
+        .real(&OutputSettings::surface_voxel_size, "Surface voxel size", 0.0, Range::non_negative(),
+              "> 0: write each frame's particle surface (OpenVDB level set of spheres of the particle spacing, "
+              "voxels of this size [m]) to DIR/surface_NNNNN.obj and DIR/surface_NNNNN.vdb; 0: none");
     return table;
   }();
   return t;
@@ -242,6 +332,65 @@ Override Override::parse(const std::string& text) {
     throw InputError("--set '" + text + "': expected Path/To/Parameter=value");
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
+
+namespace {
+void check_keyframes(const ColliderSettings& c, const std::string& file, const std::string& path) {
+  const std::size_t n = c.keyframe_times.size();
+  if (n == 0) {
+    if (!c.keyframe_positions.empty() || !c.keyframe_rotations.empty())
+      throw InputError(file + ": parameter '" + path + "/Keyframe times': keyframes need their times");
+    return;
+  }
+  for (std::size_t k = 1; k < n; ++k)
+    if (!(c.keyframe_times[k] > c.keyframe_times[k - 1]))
+      throw InputError(file + ": parameter '" + path + "/Keyframe times': must increase");
+  if (c.keyframe_positions.size() != 3 * n)
+    throw InputError(file + ": parameter '" + path + "/Keyframe positions': needs 3 numbers per keyframe time (" +
+                     std::to_string(3 * n) + "), got " + std::to_string(c.keyframe_positions.size()));
+  if (!c.keyframe_rotations.empty() && c.keyframe_rotations.size() != 3 * n)
+    throw InputError(file + ": parameter '" + path + "/Keyframe rotations': needs 3 numbers per keyframe time (" +
+                     std::to_string(3 * n) + "), got " + std::to_string(c.keyframe_rotations.size()));
+}
+
+bool has_material(const SceneConfig& scene, const std::string& name) {
+  for (const auto& m : scene.materials)
+    if (m.name == name) return true;
+  return false;
+}
+
+void read_emitters_and_regions(const Teuchos::ParameterList& root, const std::string& file, SceneConfig& scene) {
+  for_each_item(root, "Emitters", file, [&](const std::string& name, const Teuchos::ParameterList& list,
+                                            const std::string& path) {
+    EmitterSettings e = EmitterSettings::table().parse(read_parameters(list, EmitterSettings::table().specs(), file, path));
+    e.name = name;
+    if (!has_material(scene, e.material))
+      throw InputError(file + ": parameter '" + path + "/Material': no material named '" + e.material + "'");
+    if (e.velocity.norm() == 0.0) throw InputError(file + ": parameter '" + path + "/Velocity': must be non-zero");
+    if (e.stop_time <= e.start_time) throw InputError(file + ": parameter '" + path + "/Stop time': must exceed Start time");
+    if (e.shape == "disc") {
+      // A disc: a cylinder two cells thick along the velocity, so that nodes lie inside it.
+      e.shape = "cylinder";
+      e.axis = e.velocity;
+      e.length = 2.0 * scene.grid.cell_size;
+    }
+    make_shape(e, file, path);
+    scene.emitters.push_back(e);
+  });
+  for_each_item(root, "Regions", file, [&](const std::string& name, const Teuchos::ParameterList& list,
+                                           const std::string& path) {
+    RegionSettings r = RegionSettings::table().parse(read_parameters(list, RegionSettings::table().specs(), file, path));
+    r.name = name;
+    if (!has_material(scene, r.material))
+      throw InputError(file + ": parameter '" + path + "/Material': no material named '" + r.material + "'");
+    bool known = false;
+    for (const auto& b : scene.bodies) known |= b.name == r.body;
+    if (!known) throw InputError(file + ": parameter '" + path + "/Body': no body named '" + r.body + "'");
+    load_mesh(r, file, path, scene.grid.cell_size, true);
+    make_shape(r, file, path);
+    scene.regions.push_back(r);
+  });
+}
+}  // namespace
 
 SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides) {
   auto root = read_xml_file(file);
@@ -284,6 +433,7 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
     for (const auto& m : scene.materials) known |= m.name == body.material;
     if (!known) throw InputError(file + ": parameter '" + path + "/Material': no material named '" + body.material + "'");
     if (body.shape == "half_space") throw InputError(file + ": parameter '" + path + "/Shape': a body must be bounded");
+    load_mesh(body, file, path, scene.grid.cell_size, true);
     make_shape(body, file, path);
     scene.bodies.push_back(body);
   });
@@ -292,12 +442,16 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
     ColliderSettings collider =
         ColliderSettings::table().parse(read_parameters(list, ColliderSettings::table().specs(), file, path));
     collider.name = name;
+    load_mesh(collider, file, path, scene.grid.cell_size, false);
     make_shape(collider, file, path);
+    check_keyframes(collider, file, path);
     scene.colliders.push_back(collider);
   });
+  read_emitters_and_regions(*root, file, scene);
 
   // Cross-parameter checks.
-  if (scene.bodies.empty()) throw InputError(file + ": parameter 'Bodies': the scene has no bodies");
+  if (scene.bodies.empty() && scene.emitters.empty())
+    throw InputError(file + ": parameter 'Bodies': the scene has no bodies (and no emitters)");
   if (!(scene.grid.upper_corner.array() > scene.grid.lower_corner.array()).all())
     throw InputError(file + ": parameter 'Grid/Upper corner': must exceed Lower corner in every component");
   const Vec3 extent = scene.grid.upper_corner - scene.grid.lower_corner;
@@ -325,6 +479,8 @@ std::string describe_scene_parameters() {
   section("Output", OutputSettings::table().specs());
   section("Bodies/<name>", BodySettings::table().specs());
   section("Colliders/<name>", ColliderSettings::table().specs());
+  section("Emitters/<name>", EmitterSettings::table().specs());
+  section("Regions/<name>", RegionSettings::table().specs());
   for (const auto& m : materials::model_registry())
     section("Materials/<name> with Model = " + m.model + " (" + m.summary + ")", m.parameters);
   return out.str();

@@ -6,15 +6,19 @@
 #include <filesystem>
 #include <numeric>
 #include <iomanip>
+#include <sstream>
 #include <ostream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/io/checkpoint.hpp"
+#include "viscompm/geometry/level_set.hpp"
+#include "viscompm/io/collider_output.hpp"
 #include "viscompm/io/particle_file.hpp"
 #include "viscompm/materials/registry.hpp"
 #include "viscompm/parallel/migration.hpp"
 #include "viscompm/parallel/rcb_partition.hpp"
 #include "viscompm/particles/sampling.hpp"
+#include "viscompm/simulation/scene_objects.hpp"
 
 namespace viscompm::simulation {
 
@@ -34,21 +38,11 @@ materials::MaterialList make_materials(const scene::SceneConfig& scene) {
 }
 
 boundary::Boundary make_boundary(const scene::SceneConfig& scene) {
-  std::vector<boundary::Collider> colliders;
-  for (const auto& c : scene.colliders) {
-    boundary::Collider collider;
-    collider.name = c.name;
-    collider.shape = scene::shape_of(c);
-    collider.type = boundary::contact_type_from_name(c.contact);
-    collider.velocity = c.velocity;
-    collider.start_time = c.start_time;
-    collider.stop_time = c.stop_time;
-    colliders.push_back(collider);
-  }
+  std::vector<boundary::Collider> colliders = make_colliders(scene);
   boundary::DomainWalls walls;
   walls.type = boundary::contact_type_from_name(scene.grid.walls);
   walls.thickness = scene.grid.wall_thickness;
-  return boundary::Boundary(std::move(colliders), walls);
+  return boundary::Boundary(std::move(colliders), walls, make_inflows(scene));
 }
 
 particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
@@ -65,13 +59,26 @@ particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const g
     for (std::size_t m = 0; m < materials.size(); ++m)
       if (materials[m]->name() == body.material) sampling.material_id = static_cast<int>(m);
     sampling.density = materials[sampling.material_id]->density();
+    const std::size_t first = set.size();
     particles::sample_body(sampling, grid, id_offset,
                            [&](const Vec3& x) { return parallel::particle_owner(decomposition, grid, order, x) == rank; },
                            set);
+    for (const auto& region : make_regions(scene, body.name, materials)) particles::assign_region(region, first, set);
     id_offset += particles::lattice_size(sampling, grid);
   }
   return set;
 }
+
+namespace {
+// The emitters' layer counts a checkpoint carries (a restart in the middle of emission).
+void restore_emitters(std::vector<particles::Emitter>& emitters, const std::vector<double>& layers,
+                      const std::string& restart_file) {
+  if (layers.size() != emitters.size())
+    throw InputError(restart_file + ": it holds " + std::to_string(layers.size()) + " emitters, the scene " +
+                     std::to_string(emitters.size()));
+  for (std::size_t k = 0; k < emitters.size(); ++k) emitters[k].set_layers_emitted(static_cast<std::int64_t>(layers[k]));
+}
+}  // namespace
 
 Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
                        const parallel::Communicator& comm, const std::string& restart_file)
@@ -83,6 +90,7 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
       materials_(make_materials(scene)),
       boundary_(make_boundary(scene)),
       time_step_cap_(scene.simulation.max_time_step) {
+  std::vector<double> emitter_layers;  // from the checkpoint
   if (restart_file.empty()) {
     particles_ = sample_particles(scene, geometry_, order_, *decomposition_, materials_, comm.rank());
   } else {
@@ -96,6 +104,7 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
     step_ = state.step;
     frame_ = state.frame;
     time_step_cap_ = state.time_step_cap;
+    emitter_layers = state.emitter_layers;
     restarted_ = true;
     // The same rank count continues with the same ownership (bit-for-bit restarts).
     if (state.decomposition_boxes.size() == 6u * static_cast<std::size_t>(comm_.size())) {
@@ -108,6 +117,9 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
     }
     parallel::migrate_particles(comm_, *decomposition_, geometry_, order_, particles_);
   }
+  emitters_ = make_emitters(scene, geometry_, materials_);
+  if (restarted_) restore_emitters(emitters_, emitter_layers, restart_file);
+  else emit_particles();
   if (comm_.sum(static_cast<std::int64_t>(particles_.size())) == 0)
     throw InputError(scene.file + ": parameter 'Bodies': no particle falls inside the grid");
   boundary_.clamp_particles(geometry_, particles_.position);
@@ -126,7 +138,8 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
 double Simulation::suggested_time_step() const {
   double speed = 0.0;
   for (const Vec3& v : particles_.velocity) speed = std::max(speed, v.norm());
-  for (const auto& c : boundary_.colliders()) speed = std::max(speed, c.velocity_at(time_).norm());
+  for (const auto& c : boundary_.colliders()) speed = std::max(speed, c.max_speed());
+  for (const auto& e : emitters_) speed = std::max(speed, e.spec().velocity.norm());
   speed = comm_.max(speed);
   double dt = std::min(time_step_cap_, scene_.simulation.max_time_step);
   if (speed > 0.0) dt = std::min(dt, scene_.simulation.cfl * geometry_.dx / speed);
@@ -167,6 +180,7 @@ void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
   const double min_dt = scene_.simulation.min_time_step;
   while (time_ < t_end * (1.0 - 1e-14)) {
     rebalance_if_needed(summary, log);
+    emit_particles();
     double dt = suggested_time_step();
     const double remaining = t_end - time_;
     if (dt >= remaining * (1.0 - 1e-9)) dt = remaining;
@@ -234,6 +248,7 @@ std::string Simulation::write_checkpoint() {
     for (const auto& b : boxes->boxes())
       state.decomposition_boxes.insert(state.decomposition_boxes.end(),
                                        {b.lower.x(), b.lower.y(), b.lower.z(), b.upper.x(), b.upper.y(), b.upper.z()});
+  for (const auto& e : emitters_) state.emitter_layers.push_back(static_cast<double>(e.layers_emitted()));
   return io::write_checkpoint(scene_.output.directory, state, particles_, materials_, comm_);
 }
 
@@ -246,7 +261,8 @@ std::vector<io::FrameInfo> existing_frames(const std::string& directory, int las
     if (!std::filesystem::exists(path)) continue;
     std::int64_t count = 0;
     io::FileAttributes attributes = io::read_file_attributes(path, count);
-    frames.push_back({f, attributes.reals["time"], attributes.integers["step"], count});
+    frames.push_back({f, attributes.reals["time"], attributes.integers["step"], count,
+                      attributes.integers["collider_vertex_count"], attributes.integers["collider_triangle_count"]});
   }
   return frames;
 }
@@ -268,8 +284,9 @@ RunSummary Simulation::run(std::ostream& log) {
   const int checkpoint_every = scene_.output.checkpoint_every;
   auto write = [&](int frame) {
     frame_ = frame;
-    frames_.push_back(io::write_frame(directory, {frame, time_, step_, 0}, particles_, materials_, comm_));
+    frames_.push_back(io::write_frame(directory, {frame, time_, step_, 0}, particles_, materials_, comm_, frame_extras()));
     if (comm_.is_root()) io::write_xdmf(directory, frames_);
+    if (scene_.output.surface_voxel_size > 0.0) write_surface(frame);
     if (checkpoint_every > 0 && frame % checkpoint_every == 0) write_checkpoint();
   };
   if (restarted_) {
@@ -284,6 +301,11 @@ RunSummary Simulation::run(std::ostream& log) {
     log << scene_.name << ": " << particle_count << " particles, grid " << geometry_.cells.transpose() << " cells of "
         << geometry_.dx << " m, " << comm_.size() << " rank(s), " << frames << " frames"
         << (restarted_ ? ", restarted at frame " + std::to_string(frame_) : std::string()) << "\n";
+  for (const auto& e : emitters_)
+    if (comm_.is_root())
+      log << "  emitter " << e.spec().name << ": " << e.layer_size() << " particles per layer, "
+          << e.layer_size() / e.layer_interval() << " particles/s, "
+          << e.particle_mass() * e.layer_size() / e.layer_interval() << " kg/s\n";
   const int first = frame_ + 1;
   for (int frame = first; frame <= frames; ++frame) {
     advance_to(frame * frame_duration, summary, &log);
@@ -300,6 +322,46 @@ RunSummary Simulation::run(std::ostream& log) {
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   solver_log_.reset();
   return summary;
+}
+
+void Simulation::emit_particles() {
+  const int rank = comm_.rank();
+  for (auto& emitter : emitters_)
+    emitter.emit(time_, [&](const Vec3& x) { return parallel::particle_owner(*decomposition_, geometry_, order_, x) == rank; },
+                 particles_);
+}
+
+double Simulation::emitted_mass() const {
+  double mass = 0.0;
+  for (const auto& e : emitters_) mass += e.delivered_mass();
+  return mass;
+}
+
+io::FrameExtras Simulation::frame_extras() const {
+  io::FrameExtras extras;
+  io::add_collider_surfaces(boundary_, time_, geometry_.origin, geometry_.upper_corner(), extras);
+  extras.emitted_mass = emitted_mass();
+  return extras;
+}
+
+void Simulation::write_surface(int frame) const {
+  // The particles of all ranks on rank 0, as spheres of the particle spacing (h = V0^(1/3)).
+  std::vector<double> local;
+  double spacing = 0.0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    local.insert(local.end(), particles_.position[p].data(), particles_.position[p].data() + 3);
+    spacing = std::max(spacing, std::cbrt(particles_.volume0[p]));
+  }
+  const std::vector<double> all = comm_.all_gather(local);
+  spacing = comm_.max(spacing);
+  if (!comm_.is_root() || all.empty()) return;
+  std::vector<Vec3> positions(all.size() / 3);
+  for (std::size_t p = 0; p < positions.size(); ++p) positions[p] = Vec3(all[3 * p], all[3 * p + 1], all[3 * p + 2]);
+  std::ostringstream name;
+  name << scene_.output.directory << "/surface_" << std::setw(5) << std::setfill('0') << frame;
+  const geometry::TriangleMesh surface =
+      geometry::particle_surface(positions, spacing, scene_.output.surface_voxel_size, name.str() + ".vdb");
+  geometry::write_obj(surface, name.str() + ".obj");
 }
 
 }  // namespace viscompm::simulation

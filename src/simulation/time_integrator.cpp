@@ -65,6 +65,8 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
   {
     Teuchos::TimeMonitor m(*g2p_timer);
     grid_to_particles(particles, v, dt);
+    // Particle-based collisions (§5.5.1): no particle crosses a collider between nodes.
+    boundary_.collide_particles(particles.position, particles.velocity, t, dt);
   }
   {
     Teuchos::TimeMonitor m(*advect_timer);

@@ -108,12 +108,15 @@ for frame in range(3):
         check(np.allclose(np.linalg.det(bE), J * J, rtol=1e-9), "det b^E = J^2 (5.5)")
         check(np.all(p["mass"][...] > 0), "masses are positive")
 
-# The XDMF index: every frame, with datasets that exist and dimensions that match.
+# The XDMF index: every frame of the particles and of the colliders (grips and bullet), with
+# datasets that exist and dimensions that match.
 xdmf = os.path.join(out, "particles.xdmf")
 if os.path.exists(xdmf):
-    grids = ET.parse(xdmf).getroot().findall("./Domain/Grid/Grid")
+    grids = ET.parse(xdmf).getroot().findall("./Domain/Grid[@Name='particles']/Grid")
     check(len(grids) == 3, f"xdmf lists 3 frames, got {len(grids)}")
-    for grid in grids:
+    collider_grids = ET.parse(xdmf).getroot().findall("./Domain/Grid[@Name='colliders']/Grid")
+    check(len(collider_grids) == 3, f"xdmf lists the colliders of 3 frames, got {len(collider_grids)}")
+    for grid in grids + collider_grids:
         for item in grid.iter("DataItem"):
             file_name, dataset = item.text.split(":")
             with h5py.File(os.path.join(out, file_name), "r") as f:

@@ -143,7 +143,7 @@ TEST(Scene, CrossParameterCheckRejectsANegativeBulkModulus) {
 TEST(Scene, EverySceneFileParsesAndEveryModelHasAScene) {
   std::set<std::string> models_in_scenes;
   int scenes = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(inputs + "/scenes")) {
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(inputs + "/scenes")) {
     if (entry.path().extension() != ".xml") continue;
     ++scenes;
     scene::SceneConfig s;
@@ -153,7 +153,7 @@ TEST(Scene, EverySceneFileParsesAndEveryModelHasAScene) {
     // Each scene can be built: its materials from the registry.
     for (const auto& m : s.materials) EXPECT_NO_THROW(materials::find_model(m.model)->create(m.name, m.values));
   }
-  EXPECT_GE(scenes, 7);
+  EXPECT_GE(scenes, 14);  // the model scenes and the paper's (inputs/scenes/paper/)
   for (const auto& model : materials::model_names())
     EXPECT_TRUE(models_in_scenes.count(model)) << "no scene in inputs/scenes uses " << model;
 }
@@ -222,4 +222,54 @@ TEST(SolverConfiguration, ValidatesBelosAndIfpack2Parameters) {
   expect_one_line_naming(error("<ParameterList name=\"s\"><Parameter name=\"Preconditioner\" type=\"string\" "
                                "value=\"AMG\"/></ParameterList>"),
                          "solver.xml", "Preconditioner");
+}
+
+TEST(Scene, MotionsEmittersAndRegionsAreValidatedOnRead) {
+  const std::string bullet_velocity = "<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{4, 0, 0}\"/>";
+  // Keyframes: 3 numbers per keyframe, increasing times.
+  std::string file = variant(bullet_velocity,
+                             "<Parameter name=\"Keyframe times\" type=\"Array(double)\" value=\"{0, 0.1}\"/>"
+                             "<Parameter name=\"Keyframe positions\" type=\"Array(double)\" value=\"{0, 0, 0, 1, 0}\"/>");
+  expect_one_line_naming(read_error(file), file, "Colliders/bullet/Keyframe positions");
+  file = variant(bullet_velocity,
+                 "<Parameter name=\"Keyframe times\" type=\"Array(double)\" value=\"{0.2, 0.1}\"/>"
+                 "<Parameter name=\"Keyframe positions\" type=\"Array(double)\" value=\"{0, 0, 0, 1, 0, 0}\"/>");
+  expect_one_line_naming(read_error(file), file, "Colliders/bullet/Keyframe times");
+  // Emitters: a known material, a non-zero velocity, a disc nozzle by default.
+  const std::string output = "<ParameterList name=\"Output\">";
+  auto emitter = [&](const std::string& entries) {
+    return variant(output, "<ParameterList name=\"Emitters\"><ParameterList name=\"tap\">" + entries +
+                               "</ParameterList></ParameterList>" + output);
+  };
+  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"paste\"/>");
+  expect_one_line_naming(read_error(file), file, "Emitters/tap/Material");
+  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>"
+                 "<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{0, 0, 0}\"/>");
+  expect_one_line_naming(read_error(file), file, "Emitters/tap/Velocity");
+  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>"
+                 "<Parameter name=\"Mass rate\" type=\"double\" value=\"-1\"/>");
+  expect_one_line_naming(read_error(file), file, "Emitters/tap/Mass rate");
+  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>"
+                 "<Parameter name=\"Center\" type=\"Array(double)\" value=\"{0.6, 1.0, 0.36}\"/>"
+                 "<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{0, -1, 0}\"/>");
+  const auto s = scene::read_scene(file);
+  ASSERT_EQ(s.emitters.size(), 1u);
+  EXPECT_EQ(s.emitters[0].shape, "cylinder");  // a disc: a cylinder along the velocity, two cells long
+  EXPECT_EQ(s.emitters[0].axis, Vec3(0, -1, 0));
+  EXPECT_DOUBLE_EQ(s.emitters[0].length, 2 * s.grid.cell_size);
+  // Regions: a known body and material.
+  auto region = [&](const std::string& entries) {
+    return variant(output, "<ParameterList name=\"Regions\"><ParameterList name=\"core\">" + entries +
+                               "</ParameterList></ParameterList>" + output);
+  };
+  file = region("<Parameter name=\"Body\" type=\"string\" value=\"pie\"/>"
+                "<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>");
+  expect_one_line_naming(read_error(file), file, "Regions/core/Body");
+  file = region("<Parameter name=\"Body\" type=\"string\" value=\"sponge\"/>"
+                "<Parameter name=\"Shape\" type=\"string\" value=\"half_space\"/>"
+                "<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>");
+  expect_one_line_naming(read_error(file), file, "Regions/core/Shape");
+  // --set reaches the new sections.
+  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>");
+  EXPECT_EQ(scene::read_scene(file, {{"Emitters/tap/Mass rate", "0.25"}}).emitters[0].mass_rate, 0.25);
 }

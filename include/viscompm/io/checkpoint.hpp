@@ -23,6 +23,8 @@ struct RunState {
   /// The decomposition's boxes (6 numbers per rank: lower, upper) when it is not the initial
   /// block one, so that a restart on the same rank count continues bit for bit.
   std::vector<double> decomposition_boxes;
+  /// Layers each emitter has emitted (its next ids and the mass it delivered follow).
+  std::vector<double> emitter_layers;
 };
 
 std::string checkpoint_file_name(int frame);

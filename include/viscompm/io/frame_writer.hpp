@@ -18,6 +18,18 @@ struct FrameInfo {
   double time = 0.0;
   std::int64_t step = 0;
   std::int64_t particle_count = 0;  ///< global; filled by write_frame
+  std::int64_t collider_vertices = 0;   ///< of /colliders (0: no colliders in the frame)
+  std::int64_t collider_triangles = 0;
+};
+
+/// What a frame holds besides the particles: the colliders' surfaces at the frame's time
+/// (/colliders/{vertices, triangles, collider_id}) and the mass the emitters delivered so far
+/// (root attribute emitted_mass).
+struct FrameExtras {
+  std::vector<double> collider_vertices;        ///< n × 3, row-major
+  std::vector<std::int64_t> collider_triangles; ///< m × 3 vertex indices
+  std::vector<std::int64_t> collider_id;        ///< per triangle: the collider's index in the scene
+  double emitted_mass = 0.0;
 };
 
 std::string frame_file_name(int frame);
@@ -27,7 +39,8 @@ std::string frame_file_name(int frame);
 /// `id` identifies particles.
 /// Returns the frame's info with the global particle count.
 FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
-                      const materials::MaterialList& materials, const parallel::Communicator& comm);
+                      const materials::MaterialList& materials, const parallel::Communicator& comm,
+                      const FrameExtras& extras = {});
 
 /// The material names in material_id order, comma-separated (an attribute of /particles).
 std::string material_names(const materials::MaterialList& materials);

@@ -28,10 +28,19 @@ struct DerivedTensor {
   std::function<Mat3(std::size_t p)> value;
 };
 
+/// A small 2D dataset the same on every rank (rank 0 writes it), e.g. a collider surface.
+struct Table {
+  std::string path;                 ///< "group/name" (the group is created)
+  std::size_t columns = 1;
+  std::vector<double> reals;        ///< row-major; or
+  std::vector<std::int64_t> integers;
+};
+
 /// Writes `particles` (this rank's rows, in rank order) to `path`; returns the global count.
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
-                                 const std::string& material_names, const parallel::Communicator& comm);
+                                 const std::string& material_names, const parallel::Communicator& comm,
+                                 const std::vector<Table>& tables = {});
 
 /// The root attributes and particle count of a file, read without its datasets (any rank alone).
 FileAttributes read_file_attributes(const std::string& path, std::int64_t& particle_count);

@@ -8,10 +8,14 @@
 //   Solver      the solver XML file
 //   Materials   one sublist per material: "Model" and that model's parameters
 //   Bodies      one sublist per body: shape, material, sampling, initial velocity
-//   Colliders   one sublist per collider: shape, contact type, motion
+//   Colliders   one sublist per collider: shape, contact type, motion (translation, rotation,
+//               keyframes), surface velocity
+//   Emitters    one sublist per emitter: nozzle shape, material, velocity, mass rate, times
+//   Regions     one sublist per material region: body, material, shape
 //   Output      directory
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -57,6 +61,12 @@ struct ShapeSettings {
   Vec3 axis = Vec3::UnitY();
   double length = 1.0;
   Vec3 normal = Vec3::UnitY();
+  std::string mesh_file;           ///< mesh: OBJ or STL, resolved against the scene file
+  double mesh_scale = 1.0;         ///< mesh: x ↦ scale·x + Center
+  double voxel_size = 0.0;         ///< mesh: level-set voxel [m] (0: a quarter of the cell size)
+  int cut_count = 4;               ///< cuts
+  double cut_width = 0.01;         ///< cuts
+  std::shared_ptr<const DistanceField> field;  ///< mesh: loaded and placed by read_scene
 };
 
 struct BodySettings : ShapeSettings {
@@ -74,7 +84,29 @@ struct ColliderSettings : ShapeSettings {
   Vec3 velocity = Vec3::Zero();
   double start_time = 0.0;
   double stop_time = 1e30;
+  Vec3 angular_velocity = Vec3::Zero();
+  Vec3 rotation_center = Vec3::Zero();
+  RealList keyframe_times, keyframe_positions, keyframe_rotations;
+  Vec3 surface_velocity = Vec3::Zero();
   static const ParameterTable<ColliderSettings>& table();
+};
+
+struct EmitterSettings : ShapeSettings {
+  std::string name;
+  std::string material;
+  Vec3 velocity = Vec3::UnitX();
+  double mass_rate = 0.0;
+  double start_time = 0.0;
+  double stop_time = 1e30;
+  int particles_per_cell = 2;
+  static const ParameterTable<EmitterSettings>& table();
+};
+
+struct RegionSettings : ShapeSettings {
+  std::string name;
+  std::string body;
+  std::string material;
+  static const ParameterTable<RegionSettings>& table();
 };
 
 struct SolverFileSettings {
@@ -86,6 +118,7 @@ struct OutputSettings {
   std::string directory = "output";
   RealList matrix_market_steps;  ///< steps whose first Newton system is written to MatrixMarket
   int checkpoint_every = 0;      ///< frames between checkpoints (0: none)
+  double surface_voxel_size = 0.0;  ///< > 0: each frame's particle surface (OpenVDB) as OBJ and VDB
   static const ParameterTable<OutputSettings>& table();
 };
 
@@ -106,6 +139,8 @@ struct SceneConfig {
   std::vector<MaterialSettings> materials;
   std::vector<BodySettings> bodies;
   std::vector<ColliderSettings> colliders;
+  std::vector<EmitterSettings> emitters;
+  std::vector<RegionSettings> regions;
 };
 
 /// The solid described by shape parameters (already validated by read_scene).

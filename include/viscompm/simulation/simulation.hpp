@@ -12,6 +12,7 @@
 #include "viscompm/linalg/linear_solver.hpp"
 #include "viscompm/materials/material.hpp"
 #include "viscompm/parallel/decomposition.hpp"
+#include "viscompm/particles/emitter.hpp"
 #include "viscompm/scene/scene.hpp"
 #include "viscompm/simulation/time_integrator.hpp"
 
@@ -76,6 +77,18 @@ class Simulation {
   const materials::MaterialList& materials() const { return materials_; }
   TimeIntegrator& integrator() { return *integrator_; }
   const grid::GridGeometry& grid() const { return geometry_; }
+  const boundary::Boundary& boundary() const { return boundary_; }
+
+  /// Adds the particles the emitters owe by the current time (collective in effect: every rank
+  /// counts every layer and keeps the particles it owns).
+  void emit_particles();
+  const std::vector<particles::Emitter>& emitters() const { return emitters_; }
+  /// Mass delivered by all emitters so far.
+  double emitted_mass() const;
+  /// What a frame written now holds besides the particles (collider surfaces, emitted mass).
+  io::FrameExtras frame_extras() const;
+  /// Writes DIR/surface_NNNNN.{obj,vdb}: the particles' surface (Output/Surface voxel size).
+  void write_surface(int frame) const;
 
  private:
   scene::SceneConfig scene_;
@@ -86,6 +99,7 @@ class Simulation {
   materials::MaterialList materials_;
   boundary::Boundary boundary_;
   particles::ParticleSet particles_;
+  std::vector<particles::Emitter> emitters_;
   std::unique_ptr<TimeIntegrator> integrator_;
   std::unique_ptr<io::SolverLog> solver_log_;  ///< open during run()
   double time_ = 0.0;

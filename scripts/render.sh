@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Renders every frame of a viscompm output directory to PNG with ParaView's pvbatch (under a
+# private Xvfb display) and makes a movie of them with ffmpeg:
+#   OUTPUT_DIR/render/frame_NNNNN.png and OUTPUT_DIR/render/movie.mp4
+# Particles are coloured by det b^E around 1 (Figure 5.7: red above, blue below) unless --field
+# says otherwise; colliders are drawn as grey surfaces. Installs ParaView, Xvfb and ffmpeg (Debian
+# packages) when they are missing.
+#
+# Usage: scripts/render.sh OUTPUT_DIR [--field NAME] [--size WxH] [--frames all|last|N,M,...]
+#                          [--range LO HI] [--view iso|x|y|z] [--clip x|y|z] [--fps N] [--no-movie]
+set -euo pipefail
+
+usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+if [ $# -lt 1 ] || [ "$1" = "--help" ] || [ "$1" = "-h" ]; then usage; [ $# -ge 1 ] && exit 0 || exit 2; fi
+OUTPUT_DIR="$1"; shift
+if [ ! -d "$OUTPUT_DIR" ]; then echo "render.sh: $OUTPUT_DIR: no such directory" >&2; exit 2; fi
+
+FPS=24
+MOVIE=1
+forward=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --fps) FPS="$2"; shift 2 ;;
+    --no-movie) MOVIE=0; shift ;;
+    --range) forward+=("$1" "$2" "$3"); shift 3 ;;
+    --field|--size|--frames|--view|--clip) forward+=("$1" "$2"); shift 2 ;;
+    *) echo "render.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+packages=(paraview python3-paraview python3-h5py xvfb xauth ffmpeg)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "render.sh: installing ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# A private X display that does not reset between clients (ParaView's OpenGL needs one).
+display=90
+while [ -e "/tmp/.X${display}-lock" ] || [ -e "/tmp/.X11-unix/X${display}" ]; do display=$((display + 1)); done
+Xvfb ":${display}" -screen 0 1920x1080x24 -nolisten tcp -noreset >/dev/null 2>&1 &
+xvfb_pid=$!
+trap 'kill "$xvfb_pid" 2>/dev/null || true' EXIT
+for _ in $(seq 100); do [ -S "/tmp/.X11-unix/X${display}" ] && break; sleep 0.1; done
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+DISPLAY=":${display}" pvbatch "$here/render_frames.py" "$OUTPUT_DIR" "${forward[@]}" 2> >(grep -v -e '^\s*$' -e 'Warning' >&2)
+
+shopt -s nullglob
+pngs=("$OUTPUT_DIR"/render/frame_*.png)
+if [ "$MOVIE" = 1 ] && [ ${#pngs[@]} -ge 2 ]; then
+  ffmpeg -y -loglevel error -framerate "$FPS" -pattern_type glob -i "$OUTPUT_DIR/render/frame_*.png" \
+    -vf "scale=trunc(iw/2)*2:trunc(ih/2)*2" -c:v libx264 -pix_fmt yuv420p "$OUTPUT_DIR/render/movie.mp4"
+  echo "render.sh: $OUTPUT_DIR/render/movie.mp4 (${#pngs[@]} frames at $FPS fps)"
+fi
