@@ -8,7 +8,7 @@
 #include "solver_configuration_impl.hpp"
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/linalg_types.hpp"
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 
 namespace viscompm::linalg {
 
@@ -42,7 +42,7 @@ void check_known(const Teuchos::ParameterList& given, const Teuchos::ParameterLi
     const std::string& name = given.name(it);
     if (valid.isParameter(name)) continue;
     std::string reason = "unknown parameter";
-    const std::string hint = scene::closest_name(name, names);
+    const std::string hint = params::closest_name(name, names);
     if (!hint.empty()) reason += " (did you mean '" + hint + "'?)";
     throw InputError(file + ": parameter '" + path + "/" + name + "': " + reason);
   }
@@ -52,7 +52,7 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   auto impl = std::make_shared<SolverConfiguration::Impl>();
   impl->origin = origin;
   const ParameterValues values =
-      scene::read_parameters(list, SolverSettings::table().specs(), origin, "", {krylov_sublist, preconditioner_sublist});
+      params::read_parameters(list, SolverSettings::table().specs(), origin, "", {krylov_sublist, preconditioner_sublist});
   impl->settings = SolverSettings::table().parse(values);
   SolverSettings& s = impl->settings;
 
@@ -93,7 +93,7 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
 
 SolverConfiguration SolverConfiguration::read(const std::string& file) {
   SolverConfiguration c;
-  c.impl_ = parse(*scene::read_xml_file(file), file);
+  c.impl_ = parse(*params::read_xml_file(file), file);
   return c;
 }
 

@@ -7,9 +7,15 @@
 #include "viscompm/core/error.hpp"
 #include "viscompm/core/shape.hpp"
 #include "viscompm/materials/registry.hpp"
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 
 namespace viscompm::scene {
+
+using params::check_entries;
+using params::parse_value;
+using params::read_parameters;
+using params::read_xml_file;
+using params::set_entry;
 
 const ParameterTable<SimulationSettings>& SimulationSettings::table() {
   static const ParameterTable<SimulationSettings> t = [] {

@@ -13,7 +13,7 @@
 #include "viscompm/io/particle_file.hpp"
 #include "viscompm/materials/registry.hpp"
 #include "viscompm/parallel/migration.hpp"
-#include "viscompm/parallel/rcb_partition.hpp"
+#include "viscompm/linalg/rcb_partition.hpp"
 #include "viscompm/particles/sampling.hpp"
 
 namespace viscompm::simulation {
@@ -138,7 +138,7 @@ void Simulation::rebalance_if_needed(RunSummary& summary, std::ostream* log) {
   // Re-partition when the threshold is crossed, but not again while the imbalance stays at what
   // the last re-partition could reach (cells are indivisible).
   if (before <= std::max(threshold, 1.05 * balanced_imbalance_)) return;
-  auto candidate = parallel::make_rcb_decomposition(comm_, geometry_, particles_);
+  auto candidate = linalg::make_rcb_decomposition(comm_, geometry_, particles_);
   // Keep the new partition only if it balances better (cells are indivisible: on coarse grids
   // the bisection's cut may land where it cannot help).
   std::vector<double> counts(comm_.size(), 0.0);

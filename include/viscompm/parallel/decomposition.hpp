@@ -58,7 +58,7 @@ namespace viscompm::parallel {
 /// Ownership by disjoint boxes in space, one per rank (box r belongs to rank r): a node belongs
 /// to the closed box that contains its position, else to the nearest box (lowest rank on a tie;
 /// empty boxes own nothing). Boxes come from a recursive coordinate bisection of
-/// the particles (make_rcb_decomposition, Zoltan2) and are stored in checkpoints.
+/// the particles (linalg::make_rcb_decomposition, Zoltan2) and are stored in checkpoints.
 class BoxDecomposition : public Decomposition {
  public:
   struct Box {

@@ -1,4 +1,4 @@
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_StandardParameterEntryValidators.hpp>
@@ -9,7 +9,7 @@
 
 #include "viscompm/core/error.hpp"
 
-namespace viscompm::scene {
+namespace viscompm::params {
 
 namespace {
 
@@ -242,26 +242,6 @@ void set_entry(Teuchos::ParameterList& list, const std::string& name, const Para
       value);
 }
 
-Teuchos::RCP<Teuchos::ParameterList> valid_parameter_list(const std::vector<ParameterSpec>& specs) {
-  auto valid = Teuchos::rcp(new Teuchos::ParameterList);
-  for (const auto& spec : specs) {
-    auto validator = Teuchos::rcp(new SpecValidator(spec));
-    std::visit(
-        [&](const auto& v) {
-          using T = std::decay_t<decltype(v)>;
-          if constexpr (std::is_same_v<T, Vec3>) {
-            valid->set(spec.name, Teuchos::Array<double>(Teuchos::tuple(v[0], v[1], v[2])), spec.doc, validator);
-          } else if constexpr (std::is_same_v<T, RealList> || std::is_same_v<T, StringList>) {
-            valid->set(spec.name, Teuchos::Array<typename T::value_type>(v.begin(), v.end()), spec.doc, validator);
-          } else {
-            valid->set(spec.name, v, spec.doc, validator);
-          }
-        },
-        spec.default_value);
-  }
-  return valid;
-}
-
 Teuchos::RCP<Teuchos::ParameterList> read_xml_file(const std::string& file) {
   if (!std::ifstream(file).good()) throw InputError(file + ": cannot open file");
   try {
@@ -273,4 +253,4 @@ Teuchos::RCP<Teuchos::ParameterList> read_xml_file(const std::string& file) {
   }
 }
 
-}  // namespace viscompm::scene
+}  // namespace viscompm::params
