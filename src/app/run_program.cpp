@@ -48,8 +48,7 @@ int run_simulation_program(int argc, char** argv) {
       return exit_success;
     }
     const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
-    const linalg::SolverConfiguration solver =
-        linalg::SolverConfiguration::read(cl.solver_file.empty() ? scene.solver_file : cl.solver_file);
+    const linalg::SolverConfiguration solver = linalg::SolverConfiguration::read(scene.solver_file);
     simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);
     Teuchos::TimeMonitor::summarize(std::cout, false, true, false, Teuchos::Union, "viscompm:");

@@ -4,6 +4,7 @@
 #include <Teuchos_StandardParameterEntryValidators.hpp>
 #include <Teuchos_XMLParameterListHelpers.hpp>
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -179,12 +180,34 @@ ParameterValues read_parameters(const Teuchos::ParameterList& list, const std::v
   return values;
 }
 
+namespace {
+// A whole token as a double; strtod also reads "inf" and "nan", which the range check then names.
+bool read_real(const std::string& token, double& x) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  x = std::strtod(token.c_str(), &end);
+  return end == token.c_str() + token.size();
+}
+
+// The items of "{1, 2, 3}" or "1, 2, 3" (braces and commas are separators).
+std::vector<std::string> list_items(const std::string& text) {
+  std::string cleaned = text;
+  for (char& ch : cleaned)
+    if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
+  std::istringstream in(cleaned);
+  std::vector<std::string> items;
+  for (std::string item; in >> item;) items.push_back(item);
+  return items;
+}
+}  // namespace
+
 ParameterValue parse_value(const ParameterSpec& spec, const std::string& text) {
   std::istringstream in(text);
   switch (spec.type) {
     case ParameterSpec::Type::real: {
+      std::string token;
       double x;
-      if (in >> x && (in >> std::ws).eof()) return x;
+      if (in >> token && (in >> std::ws).eof() && read_real(token, x)) return x;
       break;
     }
     case ParameterSpec::Type::integer: {
@@ -197,30 +220,17 @@ ParameterValue parse_value(const ParameterSpec& spec, const std::string& text) {
       if (text == "false" || text == "0") return false;
       break;
     case ParameterSpec::Type::string: return text;
+    case ParameterSpec::Type::string_list: return list_items(text);
     case ParameterSpec::Type::real_list:
-    case ParameterSpec::Type::string_list: {
-      std::string cleaned = text;
-      for (char& ch : cleaned)
-        if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
-      std::istringstream v(cleaned);
-      if (spec.type == ParameterSpec::Type::string_list) {
-        StringList list;
-        for (std::string item; v >> item;) list.push_back(item);
-        return list;
-      }
-      RealList list;
-      double x;
-      while (v >> x) list.push_back(x);
-      if ((v >> std::ws).eof() && !list.empty()) return list;
-      break;
-    }
     case ParameterSpec::Type::vector3: {
-      std::string cleaned = text;
-      for (char& ch : cleaned)
-        if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
-      std::istringstream v(cleaned);
-      Vec3 x;
-      if (v >> x[0] >> x[1] >> x[2] && (v >> std::ws).eof()) return x;
+      RealList list;
+      for (const auto& item : list_items(text)) {
+        double x;
+        if (!read_real(item, x)) throw InputError("cannot read '" + text + "' as " + ParameterSpec::type_name(spec.type));
+        list.push_back(x);
+      }
+      if (spec.type == ParameterSpec::Type::real_list && !list.empty()) return list;
+      if (spec.type == ParameterSpec::Type::vector3 && list.size() == 3) return Vec3(list[0], list[1], list[2]);
       break;
     }
   }

@@ -1,6 +1,7 @@
 #include "viscompm/scene/scene.hpp"
 
 #include <Teuchos_ParameterList.hpp>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -84,6 +85,12 @@ Shape make_shape(const ShapeSettings& s, const std::string& file, const std::str
     throw InputError(file + ": parameter '" + path + "/Upper corner': must exceed Lower corner in every component");
   return shape;
 }
+
+// At most 2^53 grid nodes: their ids, and 3 per node for the Newton unknowns, stay exact in the
+// 64-bit integers (and doubles) that hold them.
+constexpr double max_grid_nodes = 9007199254740992.0;
+// Cell indices per dimension are ints.
+constexpr double max_cells_per_dimension = 1073741824.0;
 
 constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver", "Output", "Materials", "Bodies", "Colliders"};
 
@@ -260,6 +267,8 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   scene.solver_file = solver_path.is_absolute()
                           ? solver_path.string()
                           : (std::filesystem::path(file).parent_path() / solver_path).lexically_normal().string();
+  if (!std::filesystem::is_regular_file(scene.solver_file))
+    throw InputError(file + ": parameter 'Solver/File': cannot open '" + scene.solver_file + "'");
 
   for_each_item(*root, "Materials", file, [&](const std::string& name, const Teuchos::ParameterList& list,
                                               const std::string& path) {
@@ -305,6 +314,20 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
     throw InputError(file + ": parameter 'Grid/Cell size': the domain must be several cells wide in every direction");
   if (scene.simulation.min_time_step > scene.simulation.max_time_step)
     throw InputError(file + ": parameter 'Simulation/Min time step': exceeds Max time step");
+  // Node ids are 64-bit integers and the Newton unknowns 3 per node: bound the grid before any
+  // arithmetic in integers (doubles here, so that nothing overflows).
+  double nodes = 1.0, widest = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    nodes *= std::ceil(extent[d] / scene.grid.cell_size) + 1.0;
+    widest = std::max(widest, std::ceil(extent[d] / scene.grid.cell_size));
+  }
+  if (nodes > max_grid_nodes || widest > max_cells_per_dimension) {
+    std::ostringstream reason;
+    reason << file << ": parameter 'Grid/Cell size': " << scene.grid.cell_size << " m makes " << nodes
+           << " grid nodes (" << widest << " cells across), more than viscompm can number (" << max_grid_nodes
+           << " nodes, " << max_cells_per_dimension << " cells across)";
+    throw InputError(reason.str());
+  }
   return scene;
 }
 

@@ -13,9 +13,8 @@ namespace viscompm::scene {
 
 struct CommandLine {
   std::string input_file;               ///< the scene (or study) XML
-  std::string solver_file;              ///< --solver, empty if not given
   std::string restart_file;             ///< --restart, empty if not given
-  std::vector<Override> overrides;      ///< --set, then --output and --frames as overrides
+  std::vector<Override> overrides;      ///< --set, then --output, --frames and --solver as overrides
   bool help = false;
   std::string help_text;                ///< filled when help is true
 };
