@@ -27,7 +27,11 @@ const ParameterTable<SimulationSettings>& SimulationSettings::table() {
         .real(&S::cfl, "CFL", 0.5, Range::open_closed(0.0, 10.0), "Δt ≤ CFL·Δx / max particle speed")
         .real(&S::max_time_step, "Max time step", 1e-2, Range::positive(), "upper bound of Δt [s]")
         .real(&S::min_time_step, "Min time step", 1e-7, Range::positive(),
-              "smallest Δt tried when Newton fails before the run stops [s]")
+              "smallest Δt tried when a step fails before the run stops [s]")
+        .real(&S::time_step_growth, "Time step growth", 1.5, Range::open_closed(1.0, 10.0),
+              "after each successful step the Δt cap grows by this factor (up to Max time step)")
+        .real(&S::time_step_reduction, "Time step reduction", 0.5, {0.0, 1.0, false, false},
+              "a step that fails (Newton, or non-finite values) is retried with Δt times this factor")
         .vector3(&S::gravity, "Gravity", Vec3(0.0, -9.81, 0.0), "gravitational acceleration [m/s^2]")
         .string(&S::transfer, "Transfer", "apic", {"apic", "pic_flip"}, "particle-grid transfer (§3.4, §5.6)")
         .real(&S::flip_ratio, "FLIP ratio", 0.95, Range::closed(0.0, 1.0), "α of the PIC/FLIP blend (pic_flip only)")
@@ -236,6 +240,9 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
                  "where frames, particles.xdmf and solver.csv go (--output overrides it)")
         .integer(&OutputSettings::checkpoint_every, "Checkpoint every", 0, Range::at_least(0),
                  "write DIR/checkpoint_NNNNN.h5 every this many frames (0: never); --restart continues from one")
+        .real(&OutputSettings::checkpoint_wall_seconds, "Checkpoint wall seconds", 0.0, Range::non_negative(),
+              "also write DIR/checkpoint_step_SSSSSSSS.h5 after the step in which this many wall-clock seconds have "
+              "passed since the run started or last wrote one (the newer replaces the older); 0: never")
         .real_list(&OutputSettings::matrix_market_steps, "Matrix Market steps", {}, Range::at_least(1),
                    "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx");
     return table;

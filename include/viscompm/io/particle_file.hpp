@@ -28,10 +28,15 @@ struct DerivedTensor {
   std::function<Mat3(std::size_t p)> value;
 };
 
-/// Writes `particles` (this rank's rows, in rank order) to `path`; returns the global count.
+/// Writes `particles` (this rank's rows, in rank order) to `path` (collective), through PATH.tmp
+/// renamed when complete; returns the global count. If any rank fails to write, every rank throws
+/// SimulationError and `path` is left as it was.
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
                                  const std::string& material_names, const parallel::Communicator& comm);
+
+/// Why writing `path` may have failed: its directory missing or read-only, the disk full, ...
+std::string write_failure_reason(const std::string& path);
 
 /// The root attributes and particle count of a file, read without its datasets (any rank alone).
 FileAttributes read_file_attributes(const std::string& path, std::int64_t& particle_count);

@@ -9,7 +9,7 @@
 //   Materials   one sublist per material: "Model" and that model's parameters
 //   Bodies      one sublist per body: shape, material, sampling, initial velocity
 //   Colliders   one sublist per collider: shape, contact type, motion
-//   Output      directory
+//   Output      directory, checkpoints, MatrixMarket dumps
 #pragma once
 
 #include <string>
@@ -27,6 +27,8 @@ struct SimulationSettings {
   double cfl = 0.5;
   double max_time_step = 1e-2;
   double min_time_step = 1e-7;
+  double time_step_growth = 1.5;     ///< the Δt cap grows by this factor per successful step
+  double time_step_reduction = 0.5;  ///< Δt of a failed step is multiplied by this before the retry
   Vec3 gravity = Vec3(0.0, -9.81, 0.0);
   std::string transfer = "apic";
   double flip_ratio = 0.95;
@@ -84,6 +86,7 @@ struct OutputSettings {
   std::string directory = "output";
   RealList matrix_market_steps;  ///< steps whose first Newton system is written to MatrixMarket
   int checkpoint_every = 0;      ///< frames between checkpoints (0: none)
+  double checkpoint_wall_seconds = 0.0;  ///< wall-clock seconds between checkpoints inside frames (0: none)
   static const ParameterTable<OutputSettings>& table();
 };
 
