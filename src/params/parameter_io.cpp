@@ -2,7 +2,9 @@
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Teuchos_FileInputSource.hpp>
 #include <Teuchos_XMLParameterListHelpers.hpp>
+#include <Teuchos_XMLParameterListReader.hpp>
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
@@ -252,14 +254,91 @@ void set_entry(Teuchos::ParameterList& list, const std::string& name, const Para
       value);
 }
 
+namespace {
+// The last non-empty line of a Teuchos exception message (its reason; the lines before name the
+// Teuchos source file and the failed test).
+std::string teuchos_reason(const std::string& message) {
+  std::istringstream in(message);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t-") != std::string::npos) last = line;
+  return last.substr(0, 160);
+}
+
+// Teuchos reads a number with atof-like leniency ("none" becomes 0): numbers must be whole
+// tokens. Empty if `value` is a valid `type` (double, int or an array of them, or any other type).
+std::string number_problem(const std::string& type, const std::string& value) {
+  const bool real = type == "double" || type == "Array(double)";
+  const bool integer = type == "int" || type == "Array(int)";
+  if (!real && !integer) return {};
+  std::vector<std::string> tokens = {value};
+  if (type.rfind("Array", 0) == 0) {
+    const auto open = value.find('{'), close = value.rfind('}');
+    if (open == std::string::npos || close == std::string::npos || close < open)
+      return "value '" + value + "' is not a valid " + type + " (e.g. {1, 2, 3})";
+    tokens = list_items(value.substr(open + 1, close - open - 1));
+    for (auto& token : tokens) token.erase(std::remove(token.begin(), token.end(), ','), token.end());
+  }
+  for (const auto& token : tokens) {
+    char* end = nullptr;
+    const std::string trimmed = token.substr(0, token.find_last_not_of(" \t") + 1);
+    if (real) std::strtod(trimmed.c_str(), &end);
+    else std::strtol(trimmed.c_str(), &end, 10);
+    if (trimmed.empty() || end != trimmed.c_str() + trimmed.size())
+      return "value '" + value + "' is not a valid " + type;
+  }
+  return {};
+}
+
+// The first <Parameter> under `xml` that Teuchos cannot turn into a value (or whose number is
+// not a whole number token), as "path/name" and the reason; false if there is none.
+bool find_bad_parameter(const Teuchos::XMLObject& xml, const std::string& path, std::string& where, std::string& why) {
+  for (int i = 0; i < xml.numChildren(); ++i) {
+    const Teuchos::XMLObject& child = xml.getChild(i);
+    const std::string name = child.hasAttribute("name") ? child.getAttribute("name") : "?";
+    if (child.getTag() == "ParameterList") {
+      if (find_bad_parameter(child, joined(path, name), where, why)) return true;
+    } else if (child.getTag() == "Parameter") {
+      const std::string problem = number_problem(child.hasAttribute("type") ? child.getAttribute("type") : "",
+                                                 child.hasAttribute("value") ? child.getAttribute("value") : "");
+      if (!problem.empty()) {
+        where = joined(path, name);
+        why = problem;
+        return true;
+      }
+      Teuchos::XMLObject alone("ParameterList");
+      alone.addChild(child);
+      try {
+        Teuchos::XMLParameterListReader().toParameterList(alone);
+      } catch (const std::exception&) {
+        const std::string type = child.hasAttribute("type") ? child.getAttribute("type") : std::string();
+        where = joined(path, name);
+        why = "value '" + (child.hasAttribute("value") ? child.getAttribute("value") : std::string()) +
+              "' is not a valid " + (type.empty() ? std::string("value (no type)") : type) +
+              (type == "bool" ? " (true or false)" : type.rfind("Array", 0) == 0 ? " (e.g. {1, 2, 3})" : "");
+        return true;
+      }
+    }
+  }
+  return false;
+}
+}  // namespace
+
 Teuchos::RCP<Teuchos::ParameterList> read_xml_file(const std::string& file) {
   if (!std::ifstream(file).good()) throw InputError(file + ": cannot open file");
+  Teuchos::XMLObject xml;
   try {
-    return Teuchos::getParametersFromXmlFile(file);
+    xml = Teuchos::FileInputSource(file).getObject();
   } catch (const std::exception& e) {
-    std::string reason = e.what();
-    std::replace(reason.begin(), reason.end(), '\n', ' ');
-    throw InputError(file + ": not a valid XML parameter list (" + reason.substr(0, 200) + ")");
+    throw InputError(file + ": not a valid XML file (" + teuchos_reason(e.what()) + ")");
+  }
+  if (xml.getTag() != "ParameterList") throw InputError(file + ": not a parameter list (<" + xml.getTag() + ">)");
+  std::string where, why;
+  if (find_bad_parameter(xml, "", where, why)) fail(file, where, why);
+  try {
+    return Teuchos::rcp(new Teuchos::ParameterList(Teuchos::XMLParameterListReader().toParameterList(xml)));
+  } catch (const std::exception& e) {
+    throw InputError(file + ": not a valid XML parameter list (" + teuchos_reason(e.what()) + ")");
   }
 }
 

@@ -281,8 +281,9 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
                                               const std::string& path) {
     if (!list.isParameter("Model"))
       throw InputError(file + ": parameter '" + path + "/Model': missing (one of the registered models)");
-    const ParameterValues model_value = read_parameters(
-        Teuchos::ParameterList().set("Model", list.get<std::string>("Model")), {model_spec()}, file, path);
+    Teuchos::ParameterList model_only;  // the model first: it decides the other parameters
+    model_only.setEntry("Model", list.getEntry("Model"));
+    const ParameterValues model_value = read_parameters(model_only, {model_spec()}, file, path);
     const auto* entry = materials::find_model(model_value.string("Model"));
     std::vector<ParameterSpec> specs = {model_spec()};
     specs.insert(specs.end(), entry->parameters.begin(), entry->parameters.end());

@@ -210,6 +210,29 @@ TEST(Scene, AMissingSolverFileNamesTheSceneAndTheParameter) {
   EXPECT_NE(message.find("no_such_solver.xml"), std::string::npos) << message;
 }
 
+TEST(Scene, ValuesTeuchosCannotReadOrWouldMisreadNameTheParameter) {
+  // Teuchos would read "none" as 0 and fails on "3" as an array with a dump of its internals.
+  for (const auto& [from, to, parameter] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"\"Cell size\" type=\"double\" value=\"0.03\"", "\"Cell size\" type=\"double\" value=\"none\"", "Grid/Cell size"},
+           {"\"Gravity\" type=\"Array(double)\" value=\"{0, -9.81, 0}\"", "\"Gravity\" type=\"Array(double)\" value=\"3\"",
+            "Simulation/Gravity"},
+           {"\"Gravity\" type=\"Array(double)\" value=\"{0, -9.81, 0}\"",
+            "\"Gravity\" type=\"Array(double)\" value=\"{0, g, 0}\"", "Simulation/Gravity"},
+           {"\"Particles per cell\" type=\"int\" value=\"2\"", "\"Particles per cell\" type=\"bool\" value=\"2x\"",
+            "Bodies/sponge/Particles per cell"}}) {
+    const std::string file = variant(from, to);
+    const std::string message = read_error(file);
+    expect_one_line_naming(message, file, parameter);
+    EXPECT_NE(message.find("is not a valid"), std::string::npos) << message;
+  }
+  // The model's name of another type (found by fuzzing: it was an internal error).
+  const std::string model = variant("<Parameter name=\"Model\" type=\"string\" value=\"oldroyd_b\"/>",
+                                    "<Parameter name=\"Model\" type=\"Array(double)\" value=\"{1, 2, 3}\"/>");
+  expect_one_line_naming(read_error(model), model, "Materials/sponge/Model");
+  const std::string cut = variant("</ParameterList>", "");
+  EXPECT_NE(read_error(cut).find("not a valid XML file (XML parse error at line"), std::string::npos) << read_error(cut);
+}
+
 TEST(Scene, AGridTooFineToNumberFailsAtRead) {
   const std::string message = read_error(default_scene, {{"Grid/Cell size", "1e-9"}});
   expect_one_line_naming(message, default_scene, "Grid/Cell size");
