@@ -38,8 +38,8 @@ constexpr double sliver_fraction = 0.5;
 constexpr double rebalance_slack = 1.05;
 /// Retries shown in the log; later ones are only counted.
 constexpr int retries_logged = 10;
-/// Memory per particle, a lower estimate measured on the default scene with the assembled
-/// Hessian and Jacobi (doc/performance.md: 3.2 KiB; MueLu needs more).
+/// Memory per particle: the default scene's peak memory grows by 3.2 KiB per particle with the
+/// assembled Hessian and Jacobi (doc/contracts.md; MueLu needs more).
 constexpr double bytes_per_particle = 4096.0;
 
 // The memory this rank may use: the machine's, shared among its ranks, or the control group's

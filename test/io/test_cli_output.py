@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The viscompm program end to end, as users and scripts see it (DESIGN.md section 4):
+"""The viscompm program end to end, as users and scripts see it (doc/contracts.md):
 --help, exit codes with one-line messages, and the output read back with h5py: the HDF5 frame
 schema, the XDMF index ParaView opens, and solver.csv."""
 import argparse

@@ -1,4 +1,4 @@
-// Command lines of the programs (DESIGN.md §4), parsed with Teuchos::CommandLineProcessor:
+// Command lines of the programs (doc/contracts.md), parsed with Teuchos::CommandLineProcessor:
 //   PROGRAM INPUT.xml [--output DIR] [--frames N] [--solver SOLVER.xml] [--set "Path=value"]...
 //           [--restart CHECKPOINT.h5] [--help]
 // "--option value" and "--option=value" are both accepted; --set may repeat.

@@ -1,4 +1,4 @@
-// Preconditioner studies (DESIGN.md §4, viscompm-study): the same Newton systems solved with
+// Preconditioner studies (viscompm-study, doc/contracts.md): the same Newton systems solved with
 // several solver configurations. A problem is the first Newton system of a scene's step at a
 // given cell size and Δt (after advancing the scene to a chosen time), or a MatrixMarket file.
 // Writes DIR/study.csv (one row per problem, resolution and configuration), DIR/operators.csv
