@@ -86,6 +86,14 @@ void check_memory(const scene::SceneConfig& scene, const parallel::Communicator&
   throw InputError(reason.str());
 }
 
+materials::MaterialList make_materials(const scene::SceneConfig& scene) {
+  materials::MaterialList list;
+  for (const auto& m : scene.materials) list.push_back(materials::find_model(m.model)->create(m.name, m.values));
+  return list;
+}
+
+namespace {
+// The grid a scene asks for: cells of the given size covering [lower, upper] (rounded up).
 grid::GridGeometry make_grid(const scene::GridSettings& g) {
   grid::GridGeometry geometry;
   geometry.origin = g.lower_corner;
@@ -95,12 +103,7 @@ grid::GridGeometry make_grid(const scene::GridSettings& g) {
   return geometry;
 }
 
-materials::MaterialList make_materials(const scene::SceneConfig& scene) {
-  materials::MaterialList list;
-  for (const auto& m : scene.materials) list.push_back(materials::find_model(m.model)->create(m.name, m.values));
-  return list;
-}
-
+// Colliders and domain walls.
 boundary::Boundary make_boundary(const scene::SceneConfig& scene) {
   std::vector<boundary::Collider> colliders;
   for (const auto& c : scene.colliders) {
@@ -119,6 +122,7 @@ boundary::Boundary make_boundary(const scene::SceneConfig& scene) {
   return boundary::Boundary(std::move(colliders), walls);
 }
 
+// The particles of all bodies that this rank owns (ids independent of the rank count).
 particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
                                         grid::KernelOrder order, const parallel::Decomposition& decomposition,
                                         const materials::MaterialList& materials, int rank) {
@@ -140,6 +144,7 @@ particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const g
   }
   return set;
 }
+}  // namespace
 
 Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
                        const parallel::Communicator& comm, const std::string& restart_file)

@@ -19,17 +19,11 @@
 
 namespace viscompm::simulation {
 
-/// The grid a scene asks for: cells of the given size covering [lower, upper] (rounded up).
-grid::GridGeometry make_grid(const scene::GridSettings& grid);
+/// The scene's materials, in its order, from the registry.
 materials::MaterialList make_materials(const scene::SceneConfig& scene);
-boundary::Boundary make_boundary(const scene::SceneConfig& scene);
 /// Throws InputError naming 'Grid/Cell size' when the scene's particles cannot fit in the memory
 /// of the ranks of `comm` (an estimate made before anything is sampled; collective).
 void check_memory(const scene::SceneConfig& scene, const parallel::Communicator& comm);
-/// The particles of all bodies that this rank owns (ids independent of the rank count).
-particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
-                                        grid::KernelOrder order, const parallel::Decomposition& decomposition,
-                                        const materials::MaterialList& materials, int rank);
 
 struct RunSummary {
   std::int64_t steps = 0;
@@ -69,12 +63,6 @@ class Simulation {
   /// Advances to time t_end with adaptive steps (no output). Throws SimulationError if a step
   /// fails at the smallest Δt. Inside run(), returns false when it stopped early on a request.
   bool advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr);
-  /// Re-partitions the grid when the particle counts of the ranks drift apart (Grid/Rebalance
-  /// threshold) and migrates the particles (collective).
-  void rebalance_if_needed(RunSummary& summary, std::ostream* log);
-  const parallel::Decomposition& decomposition() const { return *decomposition_; }
-  /// The Δt the next step would try (CFL, bounds), before landing on t_end.
-  double suggested_time_step() const;
 
   double time() const { return time_; }
   std::int64_t step_count() const { return step_; }
@@ -107,6 +95,11 @@ class Simulation {
   std::chrono::steady_clock::time_point last_checkpoint_time_;
   std::string wall_checkpoint_;         ///< the last checkpoint written between frames by this run
 
+  /// Re-partitions the grid when the particle counts of the ranks drift apart (Grid/Rebalance
+  /// threshold) and migrates the particles (collective).
+  void rebalance_if_needed(RunSummary& summary, std::ostream* log);
+  /// The Δt the next step would try (CFL, bounds), before landing on the frame time.
+  double suggested_time_step() const;
   /// One step of length dt from time_, retried with smaller Δt until it succeeds.
   void take_step(double dt, RunSummary& summary, std::ostream* log);
   /// True on every rank if any rank holds a non-finite particle value.
