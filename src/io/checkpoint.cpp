@@ -88,6 +88,8 @@ particles::ParticleSet read_checkpoint(const std::string& path, const parallel::
   names = attributes.strings.count("material_names") ? attributes.strings.at("material_names") : "";
   if (attributes.real_arrays.count("decomposition_boxes"))
     state.decomposition_boxes = attributes.real_arrays.at("decomposition_boxes");
+  for (double b : state.decomposition_boxes)
+    if (!std::isfinite(b)) throw InputError(path + ": non-finite values in /decomposition_boxes");
   if (!(std::isfinite(state.time) && state.time >= 0.0 && std::isfinite(state.time_step_cap) &&
         state.time_step_cap > 0.0 && state.step >= 0 && state.frame >= 0 && std::isfinite(state.balanced_imbalance)))
     throw InputError(path + ": its time, step, frame or time-step cap cannot be those of a run");

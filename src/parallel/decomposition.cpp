@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <string>
+
+#include "viscompm/core/error.hpp"
 
 namespace viscompm::parallel {
 
@@ -26,7 +29,9 @@ BlockDecomposition::BlockDecomposition(const grid::GridGeometry& geometry, int r
     }
   }
   if (best_surface == std::numeric_limits<double>::max())
-    throw std::invalid_argument("grid too small for the number of ranks");
+    throw InputError("parameter 'Grid/Cell size': a grid of " + std::to_string(nodes_.x()) + "x" +
+                     std::to_string(nodes_.y()) + "x" + std::to_string(nodes_.z()) + " nodes cannot be split among " +
+                     std::to_string(ranks) + " ranks");
   for (int d = 0; d < 3; ++d) {
     const int p = process_grid_[d];
     cuts_[d].resize(p + 1);
