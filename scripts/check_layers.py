@@ -24,24 +24,23 @@ ALLOWED = {
     # Teuchos parameter lists: below both the scene reader and the solver configurations.
     "params": ["core"],
     "linalg": PHYSICS + ["params"],
+    # Newton's method: its settings are plain structs, its loop drives the linear algebra.
+    "newton": PHYSICS + ["params", "linalg"],
     "io": PHYSICS + ["linalg"],
-    "scene": PHYSICS + ["params", "linalg"],
-    "simulation": PHYSICS + ["params", "linalg", "io", "scene"],
-    "study": PHYSICS + ["params", "linalg", "io", "scene", "simulation"],
-    "app": PHYSICS + ["params", "linalg", "io", "scene", "simulation", "study"],
+    "scene": PHYSICS + ["params", "linalg", "newton"],
+    "simulation": PHYSICS + ["params", "linalg", "newton", "io", "scene"],
+    "study": PHYSICS + ["params", "linalg", "newton", "io", "scene", "simulation"],
+    "app": PHYSICS + ["params", "linalg", "newton", "io", "scene", "simulation", "study"],
     "apps": ["app"],
 }
 
 # Headers the physics folders must not include: they build into libviscompm_physics (Eigen, MPI).
 FORBIDDEN_IN_PHYSICS = re.compile(
     r"#include\s*[<\"](Teuchos|Tpetra|Kokkos|Belos|MueLu|Ifpack2|Xpetra|Zoltan2|Amesos2|Galeri|hdf5)")
-# Violations known when the rule was written, in files being rewritten (issues 9 and 10): reported
-# but not failed. An entry that no longer occurs fails the check, so that it is removed here.
-KNOWN = {
-    ("include/viscompm/grid/grid_layout.hpp", "particles"),
-    ("include/viscompm/implicit/newton.hpp", "linalg"),
-    ("src/implicit/newton.cpp", "Teuchos"),
-}
+# Violations tolerated while the code that has them is rewritten elsewhere, as (file, the folder
+# or library included): reported, not failed. An entry that no longer occurs fails the check, so
+# that it is removed here. (None now: the last three went with the Newton rewrite.)
+KNOWN = set()
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*"viscompm/([a-z_]+)/')
 

@@ -67,9 +67,12 @@ int run_simulation_program(int argc, char** argv) {
       std::cout << "done: " << summary.steps << " steps, " << summary.newton_iterations << " Newton iterations, "
                 << summary.linear_iterations << " CG iterations, " << summary.retries << " retries in "
                 << summary.wall_seconds << " s\n"
+                << "graph builds: " << summary.graph_builds << " in " << summary.steps << " steps ("
+                << double(summary.graph_builds) / std::max<std::int64_t>(summary.steps, 1) << " per step)\n"
                 << "per step: " << summary.owned_node_steps / std::max<std::int64_t>(summary.steps, 1)
                 << " grid nodes, " << summary.shared_node_steps / std::max<std::int64_t>(summary.steps, 1)
-                << " ghost copies, " << double(summary.particles_migrated) / std::max<std::int64_t>(summary.steps, 1)
+                << " ghost nodes, " << summary.ghost_particle_steps / std::max<std::int64_t>(summary.steps, 1)
+                << " ghost particles, " << double(summary.particles_migrated) / std::max<std::int64_t>(summary.steps, 1)
                 << " particles migrated; " << summary.particles_deleted << " particles deleted, "
                 << summary.rebalances << " rebalances\n"
                 << "output: " << scene.output.directory << "/particles.xdmf (ParaView), frame_*.h5, solver.csv\n";

@@ -18,12 +18,12 @@ std::string describe_study_parameters() {
   return text;
 }
 
-// The plot script, installed beside the program: BIN/../share/viscompm/scripts (the build tree
+// The plot scripts, installed beside the program: BIN/../share/viscompm/scripts (the build tree
 // has the same layout).
-std::string plot_script() {
+std::string plot_script(const std::string& name) {
   std::error_code error;
   const std::filesystem::path program = std::filesystem::canonical("/proc/self/exe", error);
-  return (program.parent_path() / VISCOMPM_DATA_FROM_BIN / "scripts" / "plot_study.py").lexically_normal().string();
+  return (program.parent_path() / VISCOMPM_DATA_FROM_BIN / "scripts" / name).lexically_normal().string();
 }
 }  // namespace
 
@@ -37,8 +37,9 @@ int run_study_program(int argc, char** argv) {
     options.input_name = "STUDY.xml";
     options.description =
         "viscompm-study: solve the same Newton systems (of a scene at several resolutions and time steps,\n"
-        "or MatrixMarket files) with several solver configurations. Writes DIR/study.csv, DIR/operators.csv\n"
-        "and DIR/study.png. Exit codes: 0 success, 2 bad input, 3 failure.";
+        "or MatrixMarket files) with several solver configurations (Mode = systems: DIR/study.csv,\n"
+        "DIR/operators.csv, DIR/study.png), or run whole frames of a scene once per configuration\n"
+        "(Mode = steps: DIR/steps.csv, DIR/steps.png). Exit codes: 0 success, 2 bad input, 3 failure.";
     options.frames = false;
     options.restart = false;
     options.solver = false;
@@ -51,14 +52,15 @@ int run_study_program(int argc, char** argv) {
     }
     const study::StudySettings settings = study::read_study(cl.input_file, cl.overrides);
     const int rows = study::run_study(settings, cl.input_file, comm, std::cout);
-    const std::string csv = settings.output_directory + "/study.csv";
+    const bool steps = settings.mode == "steps";
+    const std::string csv = settings.output_directory + (steps ? "/steps.csv" : "/study.csv");
     if (root) {
       std::cout << "wrote " << rows << " rows to " << csv << "\n";
       if (settings.plot) {
         // Debian's matplotlib belongs to the system Python.
         const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-        const std::string command = python + " " + plot_script() + " " + csv + " " + settings.output_directory +
-                                    "/study.png";
+        const std::string command = python + " " + plot_script(steps ? "plot_steps.py" : "plot_study.py") + " " +
+                                    csv + " " + settings.output_directory + (steps ? "/steps.png" : "/study.png");
         if (std::system(command.c_str()) != 0)
           std::cerr << "viscompm-study: no plot (needs python3 with matplotlib): " << command << "\n";
       }

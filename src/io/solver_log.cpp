@@ -16,7 +16,8 @@ SolverLog::SolverLog(const std::string& directory, bool is_root, int ranks, bool
 void SolverLog::record(std::int64_t step, int newton_iteration, const linalg::LinearSolveReport& r) {
   if (!is_root_) return;
   out_ << step << ',' << newton_iteration << ',' << r.iterations << ',' << std::setprecision(6) << r.relative_residual
-       << ',' << r.setup_seconds << ',' << r.solve_seconds << ",\"" << r.preconditioner << "\"," << ranks_ << '\n';
+       << ',' << r.setup_seconds << ',' << r.solve_seconds << ",\"" << r.preconditioner << "\"," << ranks_ << ','
+       << r.operator_seconds << ',' << r.tolerance << '\n';
   out_.flush();
 }
 

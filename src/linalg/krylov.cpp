@@ -8,13 +8,26 @@ namespace viscompm::linalg {
 KrylovSolver::KrylovSolver(const SolverConfiguration& config) : config_(config) {
   Belos::SolverFactory<scalar_type, multivector_type, operator_type> factory;
   solver_ = factory.create(config.impl().settings.krylov_solver, config.impl().krylov_parameters);
+  const auto& given = *config.impl().krylov_parameters;
+  default_tolerance_ = given.isParameter("Convergence Tolerance")
+                           ? given.get<double>("Convergence Tolerance")
+                           : solver_->getValidParameters()->get<double>("Convergence Tolerance");
+  current_tolerance_ = default_tolerance_;
 }
 
 LinearSolveReport KrylovSolver::solve(const Teuchos::RCP<const operator_type>& A,
                                       const Teuchos::RCP<operator_type>& M, multivector_type& x,
-                                      const multivector_type& b) {
+                                      const multivector_type& b, double tolerance) {
   LinearSolveReport report;
   report.preconditioner = config_.label();
+  if (tolerance <= 0.0) tolerance = default_tolerance_;
+  if (tolerance != current_tolerance_) {
+    auto params = Teuchos::rcp(new Teuchos::ParameterList);
+    params->set("Convergence Tolerance", tolerance);
+    solver_->setParameters(params);
+    current_tolerance_ = tolerance;
+  }
+  report.tolerance = tolerance;
   x.putScalar(0.0);
   auto problem = Teuchos::rcp(new Belos::LinearProblem<scalar_type, multivector_type, operator_type>(
       A, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));

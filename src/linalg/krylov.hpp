@@ -18,6 +18,11 @@ struct NearNullspace {
   Teuchos::RCP<multivector_type> rigid_body_modes;
 };
 
+/// The 6 rigid-body modes (translations, rotations e_a × x about the axes) on `dof_map`, 3 dofs
+/// per node in node order, from the owned nodes' coordinates (one row of x, y, z per node).
+Teuchos::RCP<multivector_type> rigid_body_modes(const multivector_type& coordinates,
+                                                const Teuchos::RCP<const map_type>& dof_map);
+
 class Preconditioner {
  public:
   virtual ~Preconditioner() = default;
@@ -32,13 +37,18 @@ std::unique_ptr<Preconditioner> make_preconditioner(const SolverConfiguration& c
 class KrylovSolver {
  public:
   explicit KrylovSolver(const SolverConfiguration& config);
-  /// Solves A x = b from x = 0. Failures (breakdown, no convergence) are reported, not thrown.
+  /// Solves A x = b from x = 0 to the relative residual `tolerance` (≤ 0: the configuration's).
+  /// Failures (breakdown, no convergence) are reported, not thrown.
   LinearSolveReport solve(const Teuchos::RCP<const operator_type>& A, const Teuchos::RCP<operator_type>& M,
-                          multivector_type& x, const multivector_type& b);
+                          multivector_type& x, const multivector_type& b, double tolerance = 0.0);
+  /// The configuration's relative tolerance.
+  double default_tolerance() const { return default_tolerance_; }
 
  private:
   SolverConfiguration config_;
   Teuchos::RCP<Belos::SolverManager<scalar_type, multivector_type, operator_type>> solver_;
+  double default_tolerance_ = 1e-8;
+  double current_tolerance_ = 1e-8;
 };
 
 }  // namespace viscompm::linalg

@@ -12,7 +12,8 @@
 
 namespace viscompm::linalg {
 
-void write_contiguous_matrix_market(const crs_matrix_type& A, const multivector_type& b, const std::string& prefix) {
+void write_contiguous_matrix_market(const crs_matrix_type& A, const multivector_type& b,
+                                    const multivector_type& coordinates, const std::string& prefix) {
   const auto comm = A.getRowMap()->getComm();
   const auto rows = A.getRowMap()->getNodeNumElements();
   const auto contiguous = Teuchos::rcp(new map_type(A.getRowMap()->getGlobalNumElements(), rows, 0, comm));
@@ -51,6 +52,16 @@ void write_contiguous_matrix_market(const crs_matrix_type& A, const multivector_
   using writer = Tpetra::MatrixMarket::Writer<crs_matrix_type>;
   writer::writeSparseFile(prefix + ".mtx", renumbered, "viscompm Newton matrix", "H = M + dt^2 Hess(Phi)");
   writer::writeDenseFile(prefix + "_rhs.mtx", rhs, "viscompm Newton right-hand side", "-grad E");
+  // Node k of the renumbering owns rows 3k..3k+2: the owned node map is contiguous in that order.
+  auto xyz = Teuchos::rcp(new multivector_type(
+      Teuchos::rcp(new map_type(coordinates.getMap()->getGlobalNumElements(), coordinates.getLocalLength(), 0, comm)), 3));
+  {
+    auto out = xyz->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    auto in = coordinates.getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (std::size_t r = 0; r < coordinates.getLocalLength(); ++r)
+      for (int d = 0; d < 3; ++d) out(r, d) = in(r, d);
+  }
+  writer::writeDenseFile(prefix + "_coordinates.mtx", xyz, "viscompm node coordinates", "x y z per node");
 }
 
 std::string rhs_file_for(const std::string& matrix_file) {
@@ -58,12 +69,18 @@ std::string rhs_file_for(const std::string& matrix_file) {
   return (p.parent_path() / (p.stem().string() + "_rhs" + p.extension().string())).string();
 }
 
+std::string coordinates_file_for(const std::string& matrix_file) {
+  const std::filesystem::path p(matrix_file);
+  return (p.parent_path() / (p.stem().string() + "_coordinates" + p.extension().string())).string();
+}
+
 namespace {
 // A fixed matrix behind the HessianOperator interface the preconditioners take.
 class FixedMatrix : public HessianOperator {
  public:
   explicit FixedMatrix(Teuchos::RCP<crs_matrix_type> A) : A_(std::move(A)) {}
-  bool update(const implicit::IncrementalPotential&, const NodeVectorField&, bool) override { return false; }
+  void build_pattern() override {}
+  void update(const implicit::IncrementalPotential&, const NodeVectorField&, bool) override {}
   Teuchos::RCP<const operator_type> op() const override { return A_; }
   Teuchos::RCP<crs_matrix_type> matrix() const override { return A_; }
   Teuchos::RCP<const vector_type> diagonal() const override {
@@ -72,17 +89,20 @@ class FixedMatrix : public HessianOperator {
     return d;
   }
   std::int64_t nonzeros() const override { return static_cast<std::int64_t>(A_->getGlobalNumEntries()); }
-  int pattern_builds() const override { return 1; }
 
  private:
   Teuchos::RCP<crs_matrix_type> A_;
 };
 }  // namespace
 
-MatrixMarketSolve solve_matrix_market(const std::string& matrix_file, const SolverConfiguration& config,
-                                      const parallel::Communicator& comm) {
-  if (config.impl().settings.operator_form == "matrix-free")
-    throw InputError(config.origin() + ": a matrix-free configuration cannot solve a MatrixMarket system");
+struct MatrixMarketProblem::Impl {
+  Teuchos::RCP<crs_matrix_type> A;
+  Teuchos::RCP<multivector_type> b;
+  NearNullspace modes;
+};
+
+MatrixMarketProblem::MatrixMarketProblem(const std::string& matrix_file, const parallel::Communicator& comm)
+    : impl_(std::make_unique<Impl>()) {
   if (!std::ifstream(matrix_file).good()) throw InputError(matrix_file + ": cannot open file");
   const auto tcomm = Teuchos::rcp(new Teuchos::MpiComm<int>(comm.comm()));
   using reader = Tpetra::MatrixMarket::Reader<crs_matrix_type>;
@@ -92,24 +112,57 @@ MatrixMarketSolve solve_matrix_market(const std::string& matrix_file, const Solv
   } catch (const std::exception& e) {
     throw InputError(matrix_file + ": not a readable MatrixMarket matrix");
   }
-  multivector_type b(A->getRangeMap(), 1), x(A->getDomainMap(), 1);
+  // With coordinates: rows by node, so that the 3 dofs of a node share a rank (MueLu's blocks).
+  const std::string coordinates_file = coordinates_file_for(matrix_file);
+  if (std::ifstream(coordinates_file).good()) {
+    const auto rows = A->getGlobalNumRows();
+    if (rows % 3 != 0) throw InputError(coordinates_file + ": the matrix has " + std::to_string(rows) +
+                                        " rows, not 3 per node");
+    Teuchos::RCP<const map_type> node_map = Teuchos::rcp(new map_type(rows / 3, 0, tcomm));
+    const Teuchos::RCP<const map_type> dof_map =
+        Teuchos::rcp(new map_type(rows, 3 * node_map->getNodeNumElements(), 0, tcomm));
+    const import_type to_nodes(A->getRowMap(), dof_map);
+    A = Tpetra::importAndFillCompleteCrsMatrix<crs_matrix_type>(A, to_nodes, dof_map, dof_map);
+    try {
+      impl_->modes.coordinates = reader::readDenseFile(coordinates_file, tcomm, node_map);
+    } catch (const std::exception& e) {
+      throw InputError(coordinates_file + ": not a readable MatrixMarket array of node coordinates");
+    }
+    if (impl_->modes.coordinates->getNumVectors() != 3)
+      throw InputError(coordinates_file + ": expected 3 columns (x, y, z)");
+    impl_->modes.rigid_body_modes = rigid_body_modes(*impl_->modes.coordinates, dof_map);
+  }
+  impl_->A = A;
+  impl_->b = Teuchos::rcp(new multivector_type(A->getRangeMap(), 1));
   const std::string rhs_file = rhs_file_for(matrix_file);
   if (std::ifstream(rhs_file).good()) {
     auto map = A->getRangeMap();
-    const auto read = reader::readDenseFile(rhs_file, tcomm, map);
-    b.assign(*read);
+    impl_->b->assign(*reader::readDenseFile(rhs_file, tcomm, map));
   } else {
-    b.putScalar(1.0);
+    impl_->b->putScalar(1.0);
   }
-  MatrixMarketSolve result;
-  result.rows = static_cast<std::int64_t>(A->getGlobalNumRows());
-  result.nonzeros = static_cast<std::int64_t>(A->getGlobalNumEntries());
+}
+
+MatrixMarketProblem::~MatrixMarketProblem() = default;
+
+std::int64_t MatrixMarketProblem::rows() const { return static_cast<std::int64_t>(impl_->A->getGlobalNumRows()); }
+std::int64_t MatrixMarketProblem::nonzeros() const {
+  return static_cast<std::int64_t>(impl_->A->getGlobalNumEntries());
+}
+bool MatrixMarketProblem::has_coordinates() const { return !impl_->modes.coordinates.is_null(); }
+
+MatrixMarketSolve MatrixMarketProblem::solve(const SolverConfiguration& config) const {
+  if (config.impl().settings.operator_form == "matrix-free")
+    throw InputError(config.origin() + ": a matrix-free configuration cannot solve a MatrixMarket system");
+  const auto& A = impl_->A;
+  multivector_type x(A->getDomainMap(), 1), b(*impl_->b, Teuchos::Copy);
   FixedMatrix H(A);
   auto preconditioner = make_preconditioner(config);
   const auto start = std::chrono::steady_clock::now();
-  preconditioner->setup(H, true, NearNullspace{});
+  preconditioner->setup(H, true, impl_->modes);
   const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   KrylovSolver krylov(config);
+  MatrixMarketSolve result;
   result.report = krylov.solve(A, preconditioner->op(), x, b);
   result.report.setup_seconds = setup;
   const auto apply_start = std::chrono::steady_clock::now();

@@ -1,9 +1,7 @@
 #include "viscompm/linalg/newton_system.hpp"
 
 #include <MatrixMarket_Tpetra.hpp>
-#include <Teuchos_TimeMonitor.hpp>
 #include <algorithm>
-#include <map>
 #include <chrono>
 
 #include "krylov.hpp"
@@ -26,36 +24,28 @@ struct NewtonSystem::Impl {
   std::unique_ptr<Preconditioner> preconditioner;
   KrylovSolver krylov;
   bool pattern_changed = true;  // since the last preconditioner set-up
-  bool values_changed = true;
-  double assembly_seconds = 0.0;
+  bool preconditioned = false;  // for the current pattern
+  std::uint64_t pattern_version = 0;
   NearNullspace modes;
-  std::uint64_t modes_version = 0;
 
-  void build_near_nullspace(const grid::GridLayout& layout);
+  void build_near_nullspace();
   // Owned entries of a node field into a Tpetra vector on the owned dofs, and back.
   void to_owned(const NodeVectorField& field, multivector_type& owned) const;
   void from_owned(const multivector_type& owned, NodeVectorField& field) const;
 };
 
-void NewtonSystem::Impl::build_near_nullspace(const grid::GridLayout& layout) {
+void NewtonSystem::Impl::build_near_nullspace() {
   const auto& s = space.impl();
+  const auto& partition = space.partition();
   modes.coordinates = Teuchos::rcp(new multivector_type(s.owned_node_map, 3));
-  modes.rigid_body_modes = Teuchos::rcp(new multivector_type(s.owned_dof_map, 6));
-  auto xyz = modes.coordinates->getLocalViewHost(Tpetra::Access::OverwriteAll);
-  auto rbm = modes.rigid_body_modes->getLocalViewHost(Tpetra::Access::OverwriteAll);
-  for (std::size_t i = 0; i < layout.owned_count; ++i) {
-    const Vec3 x = layout.geometry.node_position(layout.nodes[i]);
-    for (int d = 0; d < 3; ++d) xyz(i, d) = x[d];
-    for (int d = 0; d < 3; ++d) {
-      for (int m = 0; m < 6; ++m) rbm(3 * i + d, m) = 0.0;
-      rbm(3 * i + d, d) = 1.0;  // translations
+  {
+    auto xyz = modes.coordinates->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    for (std::size_t i = 0; i < partition.owned_count(); ++i) {
+      const Vec3 x = partition.geometry().node_position(partition.nodes()[i]);
+      for (int d = 0; d < 3; ++d) xyz(i, d) = x[d];
     }
-    // Rotations about the axes: e_a × x.
-    rbm(3 * i + 1, 3) = -x.z(); rbm(3 * i + 2, 3) = x.y();
-    rbm(3 * i + 0, 4) = x.z();  rbm(3 * i + 2, 4) = -x.x();
-    rbm(3 * i + 0, 5) = -x.y(); rbm(3 * i + 1, 5) = x.x();
   }
-  modes_version = space.version();
+  modes.rigid_body_modes = rigid_body_modes(*modes.coordinates, s.owned_dof_map);
 }
 
 void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
@@ -65,49 +55,65 @@ void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type
 }
 
 void NewtonSystem::Impl::from_owned(const multivector_type& owned, NodeVectorField& field) const {
-  field.assign(space.impl().local_nodes.size(), Vec3::Zero());
+  field.assign(space.impl().local_count, Vec3::Zero());
   auto view = owned.getLocalViewHost(Tpetra::Access::ReadOnly);
   double* data = field.data()->data();
   for (std::size_t r = 0; r < 3 * space.impl().owned_count; ++r) data[r] = view(r, 0);
-  space.distribute(field);
+  space.import_ghosts(field);
 }
 
 NewtonSystem::NewtonSystem(const NodeSpace& space, const SolverConfiguration& config)
-    : impl_(std::make_unique<Impl>(space, config)) {}
+    : impl_(std::make_unique<Impl>(space, config)) {
+  if (space.version() > 0) build_pattern();
+}
 
 NewtonSystem::~NewtonSystem() = default;
 
-void NewtonSystem::assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v,
-                            bool project) {
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+void NewtonSystem::build_pattern() {
   Impl& m = *impl_;
-  const auto start = std::chrono::steady_clock::now();
-  if (m.hessian->update(potential, v, project)) m.pattern_changed = true;
-  if (m.modes_version != m.space.version()) m.build_near_nullspace(potential.layout());
-  m.values_changed = true;
-  m.assembly_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  m.hessian->build_pattern();
+  m.build_near_nullspace();
+  m.pattern_version = m.space.version();
+  m.pattern_changed = true;
+  m.preconditioned = false;
 }
 
-LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorField& dv) {
+double NewtonSystem::assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v,
+                              bool project) {
   Impl& m = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  m.hessian->update(potential, v, project);
+  return seconds_since(start);
+}
+
+double NewtonSystem::precondition() {
+  Impl& m = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  m.preconditioner->setup(*m.hessian, m.pattern_changed, m.modes);
+  m.pattern_changed = false;
+  m.preconditioned = true;
+  return seconds_since(start);
+}
+
+bool NewtonSystem::preconditioned() const { return impl_->preconditioned; }
+
+std::uint64_t NewtonSystem::pattern_version() const { return impl_->pattern_version; }
+
+double NewtonSystem::default_tolerance() const { return impl_->krylov.default_tolerance(); }
+
+LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) {
+  Impl& m = *impl_;
+  const double setup_seconds = m.preconditioned ? 0.0 : precondition();
   const auto& s = m.space.impl();
   multivector_type b(s.owned_dof_map, 1), x(s.owned_dof_map, 1);
   m.to_owned(rhs, b);
-  static const auto setup_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3b newton precondition");
-  static const auto cg_timer = Teuchos::TimeMonitor::getNewCounter("viscompm: 3c newton cg");
-  double setup_seconds = 0.0;
-  if (m.values_changed) {
-    Teuchos::TimeMonitor timer(*setup_timer);
-    const auto start = std::chrono::steady_clock::now();
-    m.preconditioner->setup(*m.hessian, m.pattern_changed, m.modes);
-    setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    m.pattern_changed = false;
-    m.values_changed = false;
-  }
-  LinearSolveReport report;
-  {
-    Teuchos::TimeMonitor timer(*cg_timer);
-    report = m.krylov.solve(m.hessian->op(), m.preconditioner->op(), x, b);
-  }
+  LinearSolveReport report = m.krylov.solve(m.hessian->op(), m.preconditioner->op(), x, b, tolerance);
   report.setup_seconds = setup_seconds;
   m.from_owned(x, dv);
   return report;
@@ -127,44 +133,31 @@ std::int64_t NewtonSystem::global_rows() const {
 
 std::int64_t NewtonSystem::global_nonzeros() const { return impl_->hessian->nonzeros(); }
 bool NewtonSystem::matrix_free() const { return impl_->hessian->matrix().is_null(); }
-double NewtonSystem::assembly_seconds() const { return impl_->assembly_seconds; }
-int NewtonSystem::graph_builds() const { return impl_->hessian->pattern_builds(); }
 const SolverConfiguration& NewtonSystem::configuration() const { return impl_->config; }
 
 std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entries() const {
   const auto matrix = impl_->hessian->matrix();
   if (matrix.is_null()) throw std::logic_error("gather_entries: the operator is matrix-free");
   const auto& A = *matrix;
-  const auto& s = impl_->space.impl();
   const auto& comm = impl_->space.comm();
-  // System node id → grid node id, for every node (ids exact in doubles below 2^53).
-  std::vector<double> pairs;
-  for (std::size_t i = 0; i < s.owned_count; ++i)
-    pairs.insert(pairs.end(), {double(s.local_system_ids[i]), double(s.local_nodes[i])});
-  std::map<long long, long long> grid_of;
-  const auto all_pairs = comm.all_gather(pairs);
-  for (std::size_t k = 0; k < all_pairs.size(); k += 2)
-    grid_of[static_cast<long long>(all_pairs[k])] = static_cast<long long>(all_pairs[k + 1]);
-  auto grid_dof = [&](long long system_dof) { return 3 * grid_of.at(system_dof / 3) + system_dof % 3; };
-
+  // Local row and column dofs to grid dofs 3·(grid node id) + d (exact in doubles below 2^53).
+  const auto& nodes = impl_->space.partition().nodes();
+  auto grid_dof = [&](std::size_t local_dof) { return 3 * nodes[local_dof / 3] + static_cast<long long>(local_dof % 3); };
   std::vector<double> local;  // (row, column, value) triplets
-  const auto row_map = A.getRowMap();
-  const auto col_map = A.getColMap();
   for (std::size_t r = 0; r < A.getNodeNumRows(); ++r) {
     typename crs_matrix_type::local_inds_host_view_type cols;
     typename crs_matrix_type::values_host_view_type vals;
     A.getLocalRowView(static_cast<local_ordinal_type>(r), cols, vals);
     for (std::size_t k = 0; k < cols.extent(0); ++k) {
-      local.push_back(static_cast<double>(row_map->getGlobalElement(r)));
-      local.push_back(static_cast<double>(col_map->getGlobalElement(cols(k))));
+      local.push_back(static_cast<double>(grid_dof(r)));
+      local.push_back(static_cast<double>(grid_dof(static_cast<std::size_t>(cols(k)))));
       local.push_back(vals(k));
     }
   }
   const auto all = comm.all_gather(local);
   std::vector<std::tuple<long long, long long, double>> entries;
   for (std::size_t k = 0; k + 2 < all.size(); k += 3)
-    entries.emplace_back(grid_dof(static_cast<long long>(all[k])), grid_dof(static_cast<long long>(all[k + 1])),
-                         all[k + 2]);
+    entries.emplace_back(static_cast<long long>(all[k]), static_cast<long long>(all[k + 1]), all[k + 2]);
   std::sort(entries.begin(), entries.end());
   return entries;
 }
@@ -175,7 +168,7 @@ void NewtonSystem::write_matrix_market(const std::string& prefix, const NodeVect
   if (matrix.is_null()) throw std::logic_error("write_matrix_market: the operator is matrix-free");
   multivector_type b(m.space.impl().owned_dof_map, 1);
   m.to_owned(rhs, b);
-  write_contiguous_matrix_market(*matrix, b, prefix);
+  write_contiguous_matrix_market(*matrix, b, *m.modes.coordinates, prefix);
 }
 
 double NewtonSystem::time_apply(int repetitions) const {

@@ -8,6 +8,24 @@
 
 namespace viscompm::linalg {
 
+Teuchos::RCP<multivector_type> rigid_body_modes(const multivector_type& coordinates,
+                                                const Teuchos::RCP<const map_type>& dof_map) {
+  auto modes = Teuchos::rcp(new multivector_type(dof_map, 6));
+  auto xyz = coordinates.getLocalViewHost(Tpetra::Access::ReadOnly);
+  auto rbm = modes->getLocalViewHost(Tpetra::Access::OverwriteAll);
+  for (std::size_t i = 0; i < coordinates.getLocalLength(); ++i) {
+    const double x = xyz(i, 0), y = xyz(i, 1), z = xyz(i, 2);
+    for (int d = 0; d < 3; ++d) {
+      for (int m = 0; m < 6; ++m) rbm(3 * i + d, m) = 0.0;
+      rbm(3 * i + d, d) = 1.0;  // translations
+    }
+    rbm(3 * i + 1, 3) = -z; rbm(3 * i + 2, 3) = y;
+    rbm(3 * i + 0, 4) = z;  rbm(3 * i + 2, 4) = -x;
+    rbm(3 * i + 0, 5) = -y; rbm(3 * i + 1, 5) = x;
+  }
+  return modes;
+}
+
 namespace {
 class NoPreconditioner : public Preconditioner {
  public:

@@ -58,6 +58,27 @@ std::vector<std::int64_t> Communicator::all_gather(const std::vector<std::int64_
   return all_gather_values(local, MPI_INT64_T, comm_, size_);
 }
 
+std::vector<std::vector<char>> Communicator::exchange_bytes(const std::vector<const char*>& data,
+                                                           const std::vector<std::size_t>& bytes) const {
+  std::vector<int> send_counts(size_), recv_counts(size_), send_offsets(size_, 0), recv_offsets(size_, 0);
+  for (int r = 0; r < size_; ++r) send_counts[r] = static_cast<int>(bytes[r]);
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
+  for (int r = 1; r < size_; ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
+  }
+  std::vector<char> send_buffer(send_offsets.back() + send_counts.back());
+  for (int r = 0; r < size_; ++r)
+    if (bytes[r] > 0) std::memcpy(send_buffer.data() + send_offsets[r], data[r], bytes[r]);
+  std::vector<char> recv_buffer(recv_offsets.back() + recv_counts.back());
+  MPI_Alltoallv(send_buffer.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, recv_buffer.data(),
+                recv_counts.data(), recv_offsets.data(), MPI_BYTE, comm_);
+  std::vector<std::vector<char>> received(size_);
+  for (int r = 0; r < size_; ++r)
+    received[r].assign(recv_buffer.begin() + recv_offsets[r], recv_buffer.begin() + recv_offsets[r] + recv_counts[r]);
+  return received;
+}
+
 bool Communicator::any(bool local) const {
   int value = local ? 1 : 0;
   int global = 0;

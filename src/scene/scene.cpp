@@ -55,7 +55,13 @@ const ParameterTable<GridSettings>& GridSettings::table() {
               "re-partition the grid (Zoltan2 RCB of the particles) when the largest rank holds more than this "
               "times the mean particle count; 0 never")
         .integer(&G::wall_thickness, "Wall thickness", 2, Range::closed(1, 8),
-                 "nodes closer than this many cells to a face are wall nodes");
+                 "nodes closer than this many cells to a face are wall nodes")
+        .integer(&G::padding_cells, "Padding cells", 0, Range::closed(0, 16),
+                 "the linear system's nodes (and the Hessian's graph) reach this many cells beyond the occupied "
+                 "ones; the graph is rebuilt when a particle leaves them")
+        .real(&G::padding_lookahead, "Padding lookahead", 8.0, Range::closed(0.0, 1000.0),
+              "and further along each cell's particle velocities, as far as they move in this many steps "
+              "(at most 8 cells)");
     return table;
   }();
   return t;
@@ -101,7 +107,7 @@ constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver
 const std::vector<ParameterSpec>* fixed_section_specs(const std::string& section) {
   if (section == "Simulation") return &SimulationSettings::table().specs();
   if (section == "Grid") return &GridSettings::table().specs();
-  if (section == "Newton") return &implicit::NewtonSettings::table().specs();
+  if (section == "Newton") return &newton::NewtonSettings::table().specs();
   if (section == "Solver") return &SolverFileSettings::table().specs();
   if (section == "Output") return &OutputSettings::table().specs();
   if (section == "Bodies") return &BodySettings::table().specs();
@@ -267,7 +273,7 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   check_entries(*root, {}, std::vector<std::string>(std::begin(section_names), std::end(section_names)), file, "");
   scene.simulation = read_section<SimulationSettings>(*root, "Simulation", file);
   scene.grid = read_section<GridSettings>(*root, "Grid", file);
-  scene.newton = read_section<implicit::NewtonSettings>(*root, "Newton", file);
+  scene.newton = read_section<newton::NewtonSettings>(*root, "Newton", file);
   scene.output = read_section<OutputSettings>(*root, "Output", file);
   const auto solver = read_section<SolverFileSettings>(*root, "Solver", file);
   const std::filesystem::path solver_path(solver.file);
@@ -351,7 +357,7 @@ std::string describe_scene_parameters() {
   };
   section("Simulation", SimulationSettings::table().specs());
   section("Grid", GridSettings::table().specs());
-  section("Newton", implicit::NewtonSettings::table().specs());
+  section("Newton", newton::NewtonSettings::table().specs());
   section("Solver", SolverFileSettings::table().specs());
   section("Output", OutputSettings::table().specs());
   section("Bodies/<name>", BodySettings::table().specs());

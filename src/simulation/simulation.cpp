@@ -205,6 +205,8 @@ Simulation::Simulation(const scene::SceneConfig& scene, materials::MaterialList 
   settings.transfer.flip_ratio = scene.simulation.flip_ratio;
   settings.newton = scene.newton;
   settings.delete_outside_particles = scene.grid.outside_particles == "delete";
+  settings.padding.margin = scene.grid.padding_cells;
+  settings.padding.lookahead = scene.grid.padding_lookahead;
   integrator_ = std::make_unique<TimeIntegrator>(comm_, geometry_, order_, *decomposition_, settings, materials_,
                                                  boundary_, solver);
 }
@@ -274,10 +276,18 @@ void Simulation::take_step(double dt, RunSummary& summary, std::ostream* log) {
     const StepReport report = integrator_->step(particles_, time_, dt, dump_prefix);
     const auto& newton = report.newton;
     for (std::size_t k = 0; k < newton.linear_solves.size(); ++k) {
-      if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), newton.linear_solves[k]);
-      summary.linear_iterations += newton.linear_solves[k].iterations;
+      const auto& solve = newton.linear_solves[k];
+      if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), solve);
+      summary.linear_iterations += solve.iterations;
+      summary.operator_seconds += solve.operator_seconds;
+      summary.preconditioner_seconds += solve.setup_seconds;
+      summary.cg_seconds += solve.solve_seconds;
     }
     summary.newton_iterations += newton.iterations;
+    summary.assemblies += newton.assemblies;
+    summary.preconditioner_setups += newton.preconditioner_setups;
+    summary.line_search_seconds += newton.line_search_seconds;
+    summary.graph_builds += report.partition_rebuilt;
     std::string failure;
     if (!newton.converged) {
       failure = "Newton failed (" + newton.failure + ")";
@@ -286,6 +296,7 @@ void Simulation::take_step(double dt, RunSummary& summary, std::ostream* log) {
       particles_ = before_step_;
     }
     if (failure.empty()) {
+      summary.ghost_particle_steps += comm_.sum(static_cast<std::int64_t>(report.ghost_particles));
       summary.particles_deleted += comm_.sum(static_cast<std::int64_t>(report.particles_deleted));
       summary.particles_migrated += comm_.sum(static_cast<std::int64_t>(report.particles_sent));
       summary.shared_node_steps += comm_.sum(static_cast<std::int64_t>(report.shared_nodes));
@@ -360,9 +371,10 @@ std::string clock_text(double seconds) {
 }
 }  // namespace
 
-std::string Simulation::write_checkpoint() const { return write_checkpoint_file(io::checkpoint_file_name(frame_)); }
+std::string Simulation::write_checkpoint() { return write_checkpoint_file(io::checkpoint_file_name(frame_)); }
 
-std::string Simulation::write_checkpoint_file(const std::string& name) const {
+std::string Simulation::write_checkpoint_file(const std::string& name) {
+  integrator_->reset_reuse();  // continue as a run restarted from this checkpoint starts
   io::RunState state{time_, step_, frame_, time_step_cap_, scene_.name, {}, balanced_imbalance_};
   if (const auto* boxes = dynamic_cast<const parallel::BoxDecomposition*>(decomposition_.get()))
     for (const auto& b : boxes->boxes())
@@ -446,7 +458,8 @@ RunSummary Simulation::run(std::ostream& log) {
     if (comm_.is_root())
       log << "frame " << std::setw(4) << frame << "/" << frames << "  t = " << std::setprecision(4) << std::fixed
           << time_ << " s  steps " << summary.steps << "  newton " << summary.newton_iterations << "  cg "
-          << summary.linear_iterations << "  retries " << summary.retries << "  wall " << clock_text(elapsed)
+          << summary.linear_iterations << "  graphs " << summary.graph_builds << "  retries " << summary.retries
+          << "  wall " << clock_text(elapsed)
           << "  eta " << clock_text(elapsed / done * (frames - frame)) << std::defaultfloat << std::endl;
   }
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -2,7 +2,11 @@
 
 #include <Teuchos_TimeMonitor.hpp>
 
+#include <cmath>
+
+#include "viscompm/parallel/ghost_particles.hpp"
 #include "viscompm/parallel/migration.hpp"
+#include "viscompm/particles/binning.hpp"
 
 namespace viscompm::simulation {
 
@@ -20,7 +24,8 @@ TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::G
       materials_(materials),
       boundary_(boundary),
       space_(comm),
-      system_(space_, solver) {
+      system_(space_, solver),
+      newton_(settings.newton, system_, comm) {
   layout_.geometry = geometry;
   layout_.order = order;
 }
@@ -35,7 +40,8 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
   report.dt = dt;
   {
     Teuchos::TimeMonitor m(*layout_timer);
-    build_layout(particles);
+    report.partition_rebuilt = build_layout(particles, dt);
+    report.ghost_particles = particles.size() - layout_.own_particle_count();
   }
   report.owned_nodes = layout_.owned_count;
   report.shared_nodes = layout_.local_node_count() - layout_.owned_count;
@@ -47,15 +53,14 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
   NodeVectorField v = objective->initial_guess;
   {
     Teuchos::TimeMonitor m(*newton_timer);
-    const int builds = system_.graph_builds();
-    implicit::SystemObserver dump;
+    newton::SystemObserver dump;
     if (!dump_prefix.empty())
       dump = [&](int iteration, const linalg::NewtonSystem& system, const NodeVectorField& rhs) {
         if (iteration == 1) system.write_matrix_market(dump_prefix, rhs);
       };
-    report.newton = implicit::newton_solve(*objective->potential, space_, system_, settings_.newton, v, dump);
-    report.graph_rebuilt = system_.graph_builds() != builds;
+    report.newton = newton_.solve(*objective->potential, v, dump);
   }
+  drop_ghosts(particles);
   if (!report.newton.converged) return report;
   {
     Teuchos::TimeMonitor m(*g2p_timer);
@@ -89,22 +94,74 @@ std::unique_ptr<StepObjective> TimeIntegrator::build_objective(const particles::
   return objective;
 }
 
-void TimeIntegrator::build_layout(particles::ParticleSet& particles) {
-  const std::vector<NodeId> touched = grid::bin_particles(particles, layout_);
-  space_.update(touched, *decomposition_, layout_);
+namespace {
+// Each occupied cell padded by the margin, and further along its particles' displacement over
+// the lookahead steps (capped), so that the partition outlives the motion it can see.
+std::vector<parallel::PaddedCell> padded_cells(const particles::ParticleSet& particles, const grid::GridLayout& layout,
+                                               const PaddingSettings& padding, double dt) {
+  std::vector<parallel::PaddedCell> cells(layout.own_cell_count);
+  const double reach = padding.lookahead * dt / layout.geometry.dx;
+  for (std::size_t c = 0; c < layout.own_cell_count; ++c) {
+    Vec3 lowest = Vec3::Zero(), highest = Vec3::Zero();
+    for (std::size_t p = layout.cell_begin[c]; p < layout.cell_begin[c + 1]; ++p) {
+      lowest = lowest.cwiseMin(reach * particles.velocity[p]);
+      highest = highest.cwiseMax(reach * particles.velocity[p]);
+    }
+    cells[c].cell = layout.cells[c];
+    for (int d = 0; d < 3; ++d) {
+      cells[c].pad_below[d] = padding.margin + std::min(padding.max_padding, static_cast<int>(std::ceil(-lowest[d])));
+      cells[c].pad_above[d] = padding.margin + std::min(padding.max_padding, static_cast<int>(std::ceil(highest[d])));
+    }
+  }
+  return cells;
+}
+}  // namespace
+
+bool TimeIntegrator::build_layout(particles::ParticleSet& particles, double dt) {
+  particles::bin_particles(particles, 0, layout_);
+  layout_.own_cell_count = layout_.cells.size();
+  // A new partition when a particle's stencil left the current one, or ownership changed.
+  const bool rebuild = partition_ == nullptr || partition_decomposition_ != decomposition_ ||
+                       comm_.any(!partition_->covers(layout_.cells, 0, layout_.own_cell_count));
+  if (rebuild) {
+    partition_ = std::make_unique<parallel::NodePartition>(comm_, layout_.geometry, layout_.order, *decomposition_,
+                                                           padded_cells(particles, layout_, settings_.padding, dt));
+    partition_decomposition_ = decomposition_;
+    ++partition_builds_;
+    space_.update(*partition_);
+    system_.build_pattern();
+    layout_.nodes = partition_->nodes();
+    layout_.owned_count = partition_->owned_count();
+  }
+  // Owner computes: the neighbours' particles that reach owned nodes, binned after the own ones.
+  const std::size_t own = particles.size();
+  parallel::append_ghost_particles(comm_, *partition_, layout_, particles);
+  particles::bin_particles(particles, own, layout_);
+  partition_->index_cells(layout_.cells, 0, layout_.cell_count(), layout_.cell_nodes);
+  return rebuild;
+}
+
+bool TimeIntegrator::first_right_hand_side(const StepObjective& objective, NodeVectorField& rhs) const {
+  if (comm_.any(!objective.potential->gradient(objective.initial_guess, rhs))) return false;
+  for (Vec3& r : rhs) r = -r;
+  return true;
+}
+
+void TimeIntegrator::drop_ghosts(particles::ParticleSet& particles) const {
+  particles.resize(layout_.own_particle_count());
 }
 
 void TimeIntegrator::particles_to_grid(const particles::ParticleSet& particles) {
   transfer::particles_to_grid(particles, layout_, settings_.transfer.scheme, mass_, momentum_);
-  space_.accumulate(mass_);
-  space_.accumulate(momentum_);
   v_old_ = transfer::grid_velocity(mass_, momentum_);
+  space_.import_ghosts(mass_);
+  space_.import_ghosts(v_old_);
 }
 
 void TimeIntegrator::grid_to_particles(particles::ParticleSet& particles, const NodeVectorField& v, double dt) {
   const std::vector<Mat3> A = transfer::grid_to_particles(particles, layout_, settings_.transfer, v, v_old_, dt);
   const materials::StepContext step{dt};
-  for (std::size_t p = 0; p < particles.size(); ++p)
+  for (std::size_t p = 0; p < A.size(); ++p)
     materials_[particles.material_id[p]]->update_state(particles, p, A[p], step);
 }
 

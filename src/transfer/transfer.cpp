@@ -15,6 +15,7 @@ void particles_to_grid(const particles::ParticleSet& particles, const grid::Grid
   mass.assign(layout.local_node_count(), 0.0);
   momentum.assign(layout.local_node_count(), Vec3::Zero());
   const bool affine = scheme == Scheme::apic;
+  const int owned = static_cast<int>(layout.owned_count);
   for (std::size_t c = 0; c < layout.cell_count(); ++c) {
     for (std::size_t p = layout.cell_begin[c]; p < layout.cell_begin[c + 1]; ++p) {
       const double m = particles.mass[p];
@@ -22,6 +23,7 @@ void particles_to_grid(const particles::ParticleSet& particles, const grid::Grid
       const Vec3& v = particles.velocity[p];
       const Mat3& C = particles.affine_velocity[p];
       grid::for_each_stencil_node(layout, c, p, [&](int, int i, double w, const Vec3&) {
+        if (i >= owned) return;
         mass[i] += w * m;
         Vec3 vi = v;
         if (affine) vi += C * (layout.geometry.node_position(layout.nodes[i]) - x);
@@ -41,10 +43,10 @@ NodeVectorField grid_velocity(const NodeScalarField& mass, const NodeVectorField
 std::vector<Mat3> grid_to_particles(particles::ParticleSet& particles, const grid::GridLayout& layout,
                                     const TransferSettings& settings, const NodeVectorField& v_new,
                                     const NodeVectorField& v_old, double dt) {
-  std::vector<Mat3> A(particles.size());
+  std::vector<Mat3> A(layout.own_particle_count());
   const double inverse_inertia =
       1.0 / (grid::apic_inertia_factor(layout.order) * layout.geometry.dx * layout.geometry.dx);
-  for (std::size_t c = 0; c < layout.cell_count(); ++c) {
+  for (std::size_t c = 0; c < layout.own_cell_count; ++c) {
     for (std::size_t p = layout.cell_begin[c]; p < layout.cell_begin[c + 1]; ++p) {
       const Vec3& x = particles.position[p];
       Vec3 v_pic = Vec3::Zero(), dv = Vec3::Zero();

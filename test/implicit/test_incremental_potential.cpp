@@ -60,10 +60,14 @@ struct Problem {
     const int n = static_cast<int>(3 * layout.local_node_count());
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
     const int K = layout.nodes_per_cell();
-    E.element_hessians(v, project, [&](std::size_t c, const implicit::ElementMatrix& element) {
+    E.element_hessians(v, project, [&](std::size_t c, const implicit::ElementHessian& element) {
       const int* nodes = layout.nodes_of_cell(c);
       for (int a = 0; a < K; ++a)
-        for (int b = 0; b < K; ++b) H.block<3, 3>(3 * nodes[a], 3 * nodes[b]) += element.block<3, 3>(3 * a, 3 * b);
+        for (int b = a; b < K; ++b) {
+          const Mat3 B = E.constrained_block(element, c, a, b);
+          H.block<3, 3>(3 * nodes[a], 3 * nodes[b]) += B;
+          if (b != a) H.block<3, 3>(3 * nodes[b], 3 * nodes[a]) += B.transpose();
+        }
     });
     for (std::size_t i = 0; i < mass.size(); ++i) H.block<3, 3>(3 * i, 3 * i) += mass[i] * Mat3::Identity();
     return H;

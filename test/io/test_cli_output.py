@@ -138,7 +138,8 @@ if os.path.exists(csv_path):
         header = next(reader)
         rows = list(reader)
     check(header == ["step", "newton_iteration", "linear_iterations", "relative_residual", "setup_seconds",
-                     "solve_seconds", "preconditioner", "ranks"], f"solver.csv header {header}")
+                     "solve_seconds", "preconditioner", "ranks", "operator_seconds", "tolerance"],
+          f"solver.csv header {header}")
     check(len(rows) > 0, "solver.csv has rows")
     check(all(int(r[7]) == args.ranks for r in rows), "ranks column")
     check(all(float(r[3]) < 1e-5 for r in rows), "relative residuals meet the solver tolerance")

@@ -70,11 +70,10 @@ Entries first_newton_matrix(const std::string& scene, const parallel::Communicat
                             std::int64_t& particle_count) {
   simulation::Simulation sim(scene_named(scene), testkit::jacobi_cg(1e-12), comm);
   auto& integrator = sim.integrator();
-  integrator.build_layout(sim.particles());
-  integrator.particles_to_grid(sim.particles());
+  integrator.prepare(sim.particles(), 4e-3);
   const auto objective = integrator.build_objective(sim.particles(), 0.0, 4e-3);
   integrator.newton_system().assemble(*objective->potential, objective->initial_guess, true);
-  particle_count = comm.sum(static_cast<std::int64_t>(sim.particles().size()));
+  particle_count = comm.sum(static_cast<std::int64_t>(integrator.layout().own_particle_count()));
   return integrator.newton_system().gather_entries();
 }
 }  // namespace

@@ -28,13 +28,10 @@ linalg::LinearSolveReport solve_sponge_system(const linalg::SolverConfiguration&
                                               const parallel::Communicator& comm) {
   simulation::Simulation sim(testkit::sponge_scene(), config, comm);
   auto& integrator = sim.integrator();
-  integrator.build_layout(sim.particles());
-  integrator.particles_to_grid(sim.particles());
+  integrator.prepare(sim.particles(), 4e-3);
   const auto objective = integrator.build_objective(sim.particles(), 0.0, 4e-3);
   NodeVectorField g;
-  EXPECT_TRUE(objective->potential->gradient(objective->initial_guess, g));
-  integrator.node_space().accumulate(g);
-  for (Vec3& x : g) x = -x;
+  EXPECT_TRUE(integrator.first_right_hand_side(*objective, g));
   auto& system = integrator.newton_system();
   system.assemble(*objective->potential, objective->initial_guess, true);
   NodeVectorField dv;
@@ -77,8 +74,7 @@ TEST(SolverConfigurations, MatrixFreeHessianEqualsTheAssembledOneOnRandomVectors
   const parallel::Communicator comm(MPI_COMM_WORLD);
   simulation::Simulation sim(testkit::sponge_scene(), testkit::jacobi_cg(1e-8), comm);
   auto& integrator = sim.integrator();
-  integrator.build_layout(sim.particles());
-  integrator.particles_to_grid(sim.particles());
+  integrator.prepare(sim.particles(), 4e-3);
   const auto objective = integrator.build_objective(sim.particles(), 0.0, 4e-3);
   linalg::NewtonSystem assembled(integrator.node_space(),
                                  linalg::SolverConfiguration::read(VISCOMPM_SOURCE_DIR "/inputs/solvers/jacobi_cg.xml"));
@@ -93,7 +89,7 @@ TEST(SolverConfigurations, MatrixFreeHessianEqualsTheAssembledOneOnRandomVectors
     for (int trial = 0; trial < 3; ++trial) {
       NodeVectorField x(integrator.layout().local_node_count()), y_assembled, y_matrix_free;
       for (auto& xi : x) xi = Vec3(u(rng), u(rng), u(rng));
-      integrator.node_space().distribute(x);
+      integrator.node_space().import_ghosts(x);
       assembled.apply(x, y_assembled);
       matrix_free.apply(x, y_matrix_free);
       double difference = 0.0, norm = 0.0;

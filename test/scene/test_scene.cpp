@@ -174,7 +174,7 @@ TEST(Scene, SetOverridesOneParameterByPath) {
                                                    {"Colliders/bullet/Radius", "0.1"}});
   EXPECT_EQ(s.materials[0].values.real("Weissenberg number"), 7.0);
   EXPECT_EQ(s.simulation.gravity, Vec3(0, 0, -1));
-  EXPECT_EQ(s.newton.hessian_projection, "always");
+  EXPECT_EQ(s.newton.hessian_projection, newton::HessianProjection::always);
   EXPECT_EQ(s.colliders[2].radius, 0.1);
 }
 

@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """viscompm-study end to end: study.csv has one row per (problem, resolution, configuration) with
-the contract's columns, failed configurations are rows with converged=0, and a Newton system
-written to MatrixMarket by a run reproduces that run's solve when the study reads it back."""
+the contract's columns and the operator's preparation time, failed configurations are rows with
+converged=0 that keep the system's size, a Newton system written to MatrixMarket by a run
+reproduces that run's solve when the study reads it back and every assembled solver file
+(multigrid included: the dump carries node coordinates) solves it, and the steps mode runs whole
+frames per configuration into steps.csv."""
 import argparse
 import csv
 import os
@@ -53,7 +56,8 @@ check(result.returncode == 0, f"study exits 0: {result.stderr[-1500:]}")
 rows = list(csv.DictReader(open(os.path.join(out, "study.csv")))) if result.returncode == 0 else []
 check(rows and list(rows[0].keys()) == ["problem", "resolution", "dofs", "nonzeros", "ranks", "preconditioner",
                                         "setup_seconds", "solve_seconds", "iterations", "relative_residual",
-                                        "converged"], "study.csv columns")
+                                        "converged", "operator_seconds"], "study.csv columns")
+check(all(float(r["operator_seconds"]) > 0.0 for r in rows), "every row counts the operator's preparation")
 keys = [(r["problem"], r["resolution"], r["preconditioner"]) for r in rows]
 check(len(rows) == 2 * 2 * len(configs), f"{len(rows)} rows for 2 resolutions x 2 time steps x {len(configs)} solvers")
 check(len(set(keys)) == len(keys), "one row per (problem, resolution, preconditioner)")
@@ -76,6 +80,8 @@ result = run(args.study, study, "--output", out + "_budget", "--set", f"Solvers=
 check(result.returncode == 0, "a study with a failing configuration still exits 0")
 rows = list(csv.DictReader(open(os.path.join(out + "_budget", "study.csv")))) if result.returncode == 0 else []
 check(len(rows) == 1 and rows[0]["converged"] == "0", f"the failed solve is a row with converged=0: {rows}")
+check(len(rows) == 1 and int(rows[0]["dofs"]) > 0 and int(rows[0]["nonzeros"]) > 0,
+      f"the failed row keeps the system's size: {rows}")
 
 # MatrixMarket round trip: a run writes step 2's first Newton system; the study reads it back.
 run_dir = os.path.join(args.workdir, "run")
@@ -86,12 +92,15 @@ check(result.returncode == 0, f"run with a MatrixMarket dump exits 0: {result.st
 logged = [r for r in csv.DictReader(open(os.path.join(run_dir, "solver.csv")))
           if r["step"] == "2" and r["newton_iteration"] == "1"] if result.returncode == 0 else []
 mm_study = os.path.join(args.workdir, "mm.xml")
+assembled = ["jacobi_cg.xml"] + sorted(f for f in os.listdir(solvers)
+                                       if f.endswith(".xml") and f != "jacobi_cg.xml" and "matrix_free" not in f)
 with open(mm_study, "w") as f:
     f.write(f"""<ParameterList name="mm">
   <Parameter name="Matrix Market files" type="Array(string)" value="{{{run_dir}/newton_step_2.mtx}}"/>
-  <Parameter name="Solvers" type="Array(string)" value="{{{solvers}/jacobi_cg.xml}}"/>
+  <Parameter name="Solvers" type="Array(string)" value="{{{', '.join(os.path.join(solvers, c) for c in assembled)}}}"/>
   <Parameter name="Plot" type="bool" value="false"/>
 </ParameterList>""")
+check(os.path.exists(os.path.join(run_dir, "newton_step_2_coordinates.mtx")), "the dump carries node coordinates")
 result = run(args.study, mm_study, "--output", out + "_mm")
 check(result.returncode == 0, f"MatrixMarket study exits 0: {result.stderr[-1500:]}")
 rows = list(csv.DictReader(open(os.path.join(out + "_mm", "study.csv")))) if result.returncode == 0 else []
@@ -101,8 +110,57 @@ if logged and rows:
     check(abs(float(rows[0]["relative_residual"]) - float(logged[0]["relative_residual"]))
           <= 0.05 * float(logged[0]["relative_residual"]),
           f"and reaches the run's residual: {rows[0]['relative_residual']} vs {logged[0]['relative_residual']}")
+    check(len(rows) == len(assembled) and all(r["converged"] == "1" for r in rows),
+          f"every assembled solver file solves the dump: {[(r['preconditioner'], r['converged']) for r in rows]}")
+    check(all(int(r["dofs"]) == int(rows[0]["dofs"]) > 0 and int(r["nonzeros"]) > 0 for r in rows), "sizes")
 else:
     check(False, "MatrixMarket round trip produced rows")
+
+# The steps mode: two frames of the coarse sponge per configuration, exact and lagged Newton.
+steps_study = os.path.join(args.workdir, "steps.xml")
+with open(steps_study, "w") as f:
+    f.write(f"""<ParameterList name="steps">
+  <Parameter name="Mode" type="string" value="steps"/>
+  <Parameter name="Scene" type="string" value="{args.inputs}/scenes/shooting_sponge.xml"/>
+  <Parameter name="Frames" type="int" value="2"/>
+  <Parameter name="Scene overrides" type="Array(string)" value="{{Grid/Cell size=0.06}}"/>
+  <Parameter name="Plot" type="bool" value="false"/>
+  <ParameterList name="Configurations">
+    <ParameterList name="exact Newton">
+      <Parameter name="Solver" type="string" value="{solvers}/jacobi_cg.xml"/>
+    </ParameterList>
+    <ParameterList name="once per step">
+      <Parameter name="Solver" type="string" value="{solvers}/jacobi_cg.xml"/>
+      <Parameter name="Newton" type="Array(string)" value="{{Hessian update=every step}}"/>
+    </ParameterList>
+    <ParameterList name="paper">
+      <Parameter name="Solver" type="string" value="{solvers}/matrix_free_jacobi_cg.xml"/>
+    </ParameterList>
+  </ParameterList>
+</ParameterList>""")
+result = run(args.study, steps_study, "--output", out + "_steps")
+check(result.returncode == 0, f"steps study exits 0: {result.stderr[-1500:]}")
+rows = list(csv.DictReader(open(os.path.join(out + "_steps", "steps.csv")))) if result.returncode == 0 else []
+check([r["configuration"] for r in rows] == ["exact Newton", "once per step", "paper"], f"steps.csv rows {rows}")
+if len(rows) == 3:
+    exact, once, paper = rows
+    check(int(exact["assemblies"]) >= int(exact["newton_iterations"]) > 0, "exact Newton assembles every iteration")
+    check(int(once["assemblies"]) < int(once["newton_iterations"]), "once per step keeps H within a step")
+    check(int(once["assemblies"]) >= int(once["steps"]), "and assembles at least once per step")
+    check(exact["steps"] == paper["steps"], "the same steps whatever the operator")
+    for r in rows:
+        phases = sum(float(r[k]) for k in ("operator_seconds", "preconditioner_seconds", "cg_seconds",
+                                          "line_search_seconds"))
+        check(0.0 < phases <= float(r["wall_seconds"]) * 1.001, f"phases within the wall time: {r}")
+        check(abs(float(r["seconds_per_frame"]) * 2 - float(r["wall_seconds"])) < 1e-7 * float(r["wall_seconds"]),
+              "seconds per frame")
+# A steps study whose configuration names a Newton parameter that does not exist is bad input.
+with open(steps_study) as f:
+    bad = f.read().replace("Hessian update=every step", "Hessian updates=every step")
+with open(steps_study, "w") as f:
+    f.write(bad)
+result = run(args.study, steps_study, "--output", out + "_bad")
+check(result.returncode == 2 and "Hessian updates" in result.stderr, f"bad Newton override: {result.stderr[-500:]}")
 
 print(f"{len(failures)} failure(s)")
 sys.exit(1 if failures else 0)

@@ -4,6 +4,8 @@
 #include <random>
 
 #include "viscompm/grid/grid_layout.hpp"
+#include "viscompm/parallel/node_partition.hpp"
+#include "viscompm/particles/binning.hpp"
 #include "viscompm/particles/particle_set.hpp"
 
 namespace viscompm::testkit {
@@ -40,15 +42,22 @@ Vec9 finite_difference_gradient(F&& f, const Mat3& x, double h) {
   return g;
 }
 
-/// A layout for one rank: every touched node is owned.
+/// A layout for one rank without padding: the nodes are those the particles touch, all owned.
 inline grid::GridLayout serial_layout(particles::ParticleSet& particles, const grid::GridGeometry& geometry,
                                       grid::KernelOrder order) {
   grid::GridLayout layout;
   layout.geometry = geometry;
   layout.order = order;
-  layout.nodes = grid::bin_particles(particles, layout);
-  layout.owned_count = layout.nodes.size();
-  grid::index_cell_nodes(layout);
+  particles::bin_particles(particles, 0, layout);
+  layout.own_cell_count = layout.cells.size();
+  std::vector<parallel::PaddedCell> cells;
+  for (const NodeId c : layout.cells) cells.push_back({c, Int3::Zero(), Int3::Zero()});
+  const parallel::Communicator self(MPI_COMM_SELF);
+  const parallel::BlockDecomposition one_block(geometry, 1);
+  const parallel::NodePartition partition(self, geometry, order, one_block, cells);
+  layout.nodes = partition.nodes();
+  layout.owned_count = partition.owned_count();
+  partition.index_cells(layout.cells, 0, layout.cell_count(), layout.cell_nodes);
   return layout;
 }
 

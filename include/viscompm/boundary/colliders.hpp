@@ -12,6 +12,7 @@
 
 #include "viscompm/core/shape.hpp"
 #include "viscompm/grid/grid_layout.hpp"
+#include "viscompm/particles/particle_set.hpp"
 
 namespace viscompm::boundary {
 

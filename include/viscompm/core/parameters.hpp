@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -91,6 +92,23 @@ class ParameterTable {
                          std::vector<std::string> choices, std::string doc) {
     return bind(member, make(std::move(name), ParameterSpec::Type::string, std::move(default_value), {},
                              std::move(choices), std::move(doc)));
+  }
+  /// A string from a fixed list, parsed once into an enum: `choices` pairs each name with its value.
+  template <class Enum>
+  ParameterTable& choice(Enum Struct::*member, std::string name, Enum default_value,
+                         std::vector<std::pair<std::string, Enum>> choices, std::string doc) {
+    std::vector<std::string> names;
+    std::string default_name;
+    for (const auto& [n, e] : choices) {
+      names.push_back(n);
+      if (e == default_value) default_name = n;
+    }
+    specs_.push_back(make(std::move(name), ParameterSpec::Type::string, default_name, {}, std::move(names), std::move(doc)));
+    setters_.push_back([member, choices](Struct& s, const ParameterValue& v) {
+      for (const auto& [n, e] : choices)
+        if (n == std::get<std::string>(v)) s.*member = e;
+    });
+    return *this;
   }
   ParameterTable& vector3(Vec3 Struct::*member, std::string name, Vec3 default_value, std::string doc) {
     return bind(member, make(std::move(name), ParameterSpec::Type::vector3, default_value, {}, {}, std::move(doc)));

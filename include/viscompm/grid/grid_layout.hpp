@@ -1,6 +1,8 @@
-// The grid as one step sees it: which nodes this rank holds (owned first, then shared), the
-// occupied cells (a cell = the stencil every particle with the same stencil base touches: the
-// "element" of the assembly), and each particle's stencil. Particles are sorted by cell.
+// The grid as one step sees it: the local nodes (owned by this rank first, then ghost nodes owned
+// by neighbours), the occupied cells (a cell = the stencil shared by every particle with the same
+// stencil base: the "element" of the assembly) and each particle's stencil. Cells of this rank's
+// particles come first, then cells of ghost particles (copies of neighbours' particles whose
+// stencils reach owned nodes), each part sorted by grid id; particles are sorted the same way.
 #pragma once
 
 #include <cstddef>
@@ -9,7 +11,6 @@
 #include "viscompm/core/types.hpp"
 #include "viscompm/grid/bspline.hpp"
 #include "viscompm/grid/grid_geometry.hpp"
-#include "viscompm/particles/particle_set.hpp"
 
 namespace viscompm::grid {
 
@@ -17,37 +18,32 @@ struct GridLayout {
   KernelOrder order = KernelOrder::quadratic;
   GridGeometry geometry;
 
-  /// Local nodes by global id: [0, owned_count) owned by this rank, then shared ones.
+  /// Local nodes by grid id: [0, owned_count) owned by this rank (ascending), then ghost nodes.
   std::vector<NodeId> nodes;
   std::size_t owned_count = 0;
 
-  /// Occupied cells: global id of the stencil base node, ascending.
+  /// Occupied cells: grid id of the stencil base node; [0, own_cell_count) hold this rank's
+  /// particles, the rest ghost particles.
   std::vector<NodeId> cells;
+  std::size_t own_cell_count = 0;
   /// Particles of cell c are [cell_begin[c], cell_begin[c + 1]).
-  std::vector<std::size_t> cell_begin;
-  /// Local node index of the stencil nodes of every cell (stencil_size per cell, a fastest).
+  std::vector<std::size_t> cell_begin{0};
+  /// Local node index of the stencil nodes of every cell (stencil_size per cell, x fastest).
   std::vector<int> cell_nodes;
-  /// Stencil of every particle.
+  /// Stencil of every particle (own and ghost).
   std::vector<Stencil> stencils;
 
   int nodes_per_cell() const { return stencil_size(order); }
   std::size_t cell_count() const { return cells.size(); }
   std::size_t local_node_count() const { return nodes.size(); }
+  /// Particles [0, own_particle_count()) are this rank's; the rest are ghost copies.
+  std::size_t own_particle_count() const { return cell_begin[own_cell_count]; }
   const int* nodes_of_cell(std::size_t c) const { return cell_nodes.data() + c * nodes_per_cell(); }
+  bool is_owned(int local_node) const { return static_cast<std::size_t>(local_node) < owned_count; }
 
-  /// Σ_i f_i w_ip for particle p of cell c.
-  Vec3 interpolate(std::size_t c, std::size_t p, const NodeVectorField& f) const;
   /// Σ_i f_i (∇w_ip)^T for particle p of cell c.
   Mat3 gradient(std::size_t c, std::size_t p, const NodeVectorField& f) const;
 };
-
-/// Sorts particles by (cell, id), fills stencils, cells and cell_begin, and returns the sorted
-/// global ids of every node the particles touch. Throws SimulationError if a particle's stencil
-/// leaves the grid.
-std::vector<NodeId> bin_particles(particles::ParticleSet& particles, GridLayout& layout);
-
-/// Fills cell_nodes from `nodes` (which must contain every touched node).
-void index_cell_nodes(GridLayout& layout);
 
 /// Calls f(k, node_lid, w, grad_w) for the stencil nodes of particle p in cell c.
 template <class F>

@@ -12,7 +12,8 @@ namespace viscompm::io {
 class SolverLog {
  public:
   static constexpr const char* header =
-      "step,newton_iteration,linear_iterations,relative_residual,setup_seconds,solve_seconds,preconditioner,ranks";
+      "step,newton_iteration,linear_iterations,relative_residual,setup_seconds,solve_seconds,preconditioner,ranks,"
+      "operator_seconds,tolerance";
 
   /// Opens DIR/solver.csv on rank 0 (append keeps earlier rows, e.g. after a restart).
   SolverLog(const std::string& directory, bool is_root, int ranks, bool append = false);

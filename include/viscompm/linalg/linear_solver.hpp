@@ -12,8 +12,10 @@ namespace viscompm::linalg {
 struct LinearSolveReport {
   int iterations = 0;
   double relative_residual = 0.0;  ///< ‖b − A x‖ / ‖b‖, computed after the solve
-  double setup_seconds = 0.0;      ///< preconditioner set-up
+  double operator_seconds = 0.0;   ///< preparing H for this solve: assembly or matrix-free set-up (0: reused)
+  double setup_seconds = 0.0;      ///< preconditioner set-up (0: reused)
   double solve_seconds = 0.0;      ///< Krylov iterations
+  double tolerance = 0.0;          ///< the relative residual CG had to reach
   bool converged = false;
   std::string preconditioner;      ///< the configuration's label
 };

@@ -1,8 +1,9 @@
 // The Newton matrix H = M + Δt² ∇²Φ and its solve with Belos CG and the configured
-// preconditioner. H is either assembled from per-cell element matrices into a Tpetra
-// FECrsMatrix (owned and shared rows, zeroed each assembly, shared rows summed into their
-// owners; the graph is built once per set of occupied cells and reused while the particles keep
-// the same cells), or applied matrix-free from the same per-particle pieces (the paper's §5.7).
+// preconditioner. H is either assembled (owner computes: owned rows from own and ghost
+// particles) into a Tpetra CrsMatrix whose graph is the node partition's windows, built once per
+// partition, or applied matrix-free from the same per-particle pieces (the paper's §5.7). The
+// three phases are separate calls, so that a Newton strategy can reuse H or its preconditioner:
+// assemble, precondition, solve.
 #pragma once
 
 #include <cstdint>
@@ -19,17 +20,31 @@ namespace viscompm::linalg {
 
 class NewtonSystem {
  public:
+  /// A system on `space` (its pattern is built at once if the space has a partition).
   NewtonSystem(const NodeSpace& space, const SolverConfiguration& config);
   ~NewtonSystem();
   NewtonSystem(const NewtonSystem&) = delete;
   NewtonSystem& operator=(const NewtonSystem&) = delete;
 
+  /// Builds H's sparsity pattern for the NodeSpace's current partition (collective): call after
+  /// every NodeSpace::update.
+  void build_pattern();
   /// Assembles H at grid velocities v (collective); particle Hessians projected to PSD if
-  /// `project`.
-  void assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project);
-  /// Solves H dv = rhs from dv = 0 (rhs: totals on the local nodes, owned entries used); dv is
-  /// returned on all local nodes. Sets up the preconditioner first if H changed.
-  LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv);
+  /// `project`. Returns the seconds it took.
+  double assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project);
+  /// Sets up the preconditioner for the current H (or refreshes it, reusing what the solver file's
+  /// reuse options allow). Returns the seconds it took.
+  double precondition();
+  /// The NodeSpace version the pattern was built for.
+  std::uint64_t pattern_version() const;
+  /// True once precondition() has run for the current sparsity pattern.
+  bool preconditioned() const;
+  /// Solves H dv = rhs from dv = 0 to the relative residual `tolerance` (≤ 0: the solver file's)
+  /// with the last preconditioner (set up first if there is none); rhs on the owned nodes, dv
+  /// returned on all local nodes.
+  LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance = 0.0);
+  /// The solver file's relative CG tolerance.
+  double default_tolerance() const;
 
   /// y = H x (x and y on all local nodes; owned entries of x are used). Collective.
   void apply(const NodeVectorField& x, NodeVectorField& y) const;
@@ -38,10 +53,6 @@ class NewtonSystem {
   /// Entries of the assembled matrix; -1 when matrix-free.
   std::int64_t global_nonzeros() const;
   bool matrix_free() const;
-  /// Seconds spent in the last assemble().
-  double assembly_seconds() const;
-  /// How many times the graph has been built.
-  int graph_builds() const;
   /// Every entry of H as (row, column, value) with grid dof ids 3·(grid node id) + d, which do not
   /// depend on the rank count; on every rank, sorted (collective; assembled operators only).
   std::vector<std::tuple<long long, long long, double>> gather_entries() const;

@@ -1,16 +1,15 @@
-// Which rank owns which grid node, and moving node data between the copies of a node. Each
-// node touched by particles is owned by exactly one of the ranks that touch it (its block owner
-// when that rank touches it, else the lowest such rank); the matrix rows follow that ownership.
-// Trilinos stays behind this header: Tpetra maps, Import and Export live in the implementation.
+// The Tpetra view of a NodePartition: maps of the owned nodes and dofs (contiguous system ids,
+// 3 dofs per node, all on the node's owner), column maps of owned then ghost nodes, and the
+// Imports that copy owners' values to the ghost copies. Built once per partition, reused by
+// every step while the partition lives. Trilinos stays behind this header.
 #pragma once
 
 #include <cstdint>
 #include <memory>
-#include <vector>
 
-#include "viscompm/grid/grid_layout.hpp"
+#include "viscompm/core/types.hpp"
 #include "viscompm/parallel/communicator.hpp"
-#include "viscompm/parallel/decomposition.hpp"
+#include "viscompm/parallel/node_partition.hpp"
 
 namespace viscompm::linalg {
 
@@ -21,21 +20,18 @@ class NodeSpace {
   NodeSpace(const NodeSpace&) = delete;
   NodeSpace& operator=(const NodeSpace&) = delete;
 
-  /// Orders the local nodes of `layout` (owned first, then shared) given the nodes its
-  /// particles touch, and indexes its cells. Maps are rebuilt only when some rank's touched
-  /// set changed; returns true if they were.
-  bool update(const std::vector<NodeId>& touched, const parallel::Decomposition& decomposition,
-              grid::GridLayout& layout);
+  /// Builds the maps and Imports of `partition` (collective). Call again when the partition is
+  /// rebuilt; version() then increments.
+  void update(const parallel::NodePartition& partition);
 
-  /// Sums the per-rank partial values of every node; afterwards every copy holds the total.
-  void accumulate(NodeScalarField& field) const;
-  void accumulate(NodeVectorField& field) const;
-  /// Copies each owner's value to the shared copies of its nodes.
-  void distribute(NodeVectorField& field) const;
+  /// Copies each owner's value to the ghost copies of its nodes (collective).
+  void import_ghosts(NodeScalarField& field) const;
+  void import_ghosts(NodeVectorField& field) const;
 
-  /// Global number of nodes with particles nearby.
+  const parallel::NodePartition& partition() const { return *partition_; }
+  /// Global number of nodes in the system.
   std::int64_t global_node_count() const;
-  /// Incremented every time the maps are rebuilt.
+  /// Incremented every time update() builds new maps.
   std::uint64_t version() const;
   const parallel::Communicator& comm() const { return comm_; }
 
@@ -44,6 +40,7 @@ class NodeSpace {
 
  private:
   parallel::Communicator comm_;
+  const parallel::NodePartition* partition_ = nullptr;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -5,6 +5,8 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 #include <vector>
 
 namespace viscompm::parallel {
@@ -26,14 +28,40 @@ class Communicator {
   /// Every rank's values, concatenated in rank order, on every rank.
   std::vector<double> all_gather(const std::vector<double>& local) const;
   std::vector<std::int64_t> all_gather(const std::vector<std::int64_t>& local) const;
+  /// Personalised exchange: outgoing[r] goes to rank r (outgoing has size() entries); returns
+  /// what every rank sent to this one, by source rank. Collective; T must be trivially copyable.
+  template <class T>
+  std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& outgoing) const;
   /// True on every rank if `local` is true on any rank.
   bool any(bool local) const;
   void barrier() const;
 
  private:
+  /// Byte-level exchange behind exchange<T>.
+  std::vector<std::vector<char>> exchange_bytes(const std::vector<const char*>& data,
+                                                const std::vector<std::size_t>& bytes) const;
+
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;
 };
+
+template <class T>
+std::vector<std::vector<T>> Communicator::exchange(const std::vector<std::vector<T>>& outgoing) const {
+  static_assert(std::is_trivially_copyable_v<T>);
+  std::vector<const char*> data(size_);
+  std::vector<std::size_t> bytes(size_);
+  for (int r = 0; r < size_; ++r) {
+    data[r] = reinterpret_cast<const char*>(outgoing[r].data());
+    bytes[r] = outgoing[r].size() * sizeof(T);
+  }
+  const auto received = exchange_bytes(data, bytes);
+  std::vector<std::vector<T>> incoming(size_);
+  for (int r = 0; r < size_; ++r) {
+    incoming[r].resize(received[r].size() / sizeof(T));
+    if (!received[r].empty()) std::memcpy(static_cast<void*>(incoming[r].data()), received[r].data(), received[r].size());
+  }
+  return incoming;
+}
 
 }  // namespace viscompm::parallel

@@ -4,7 +4,7 @@
 //
 //   Simulation  frames, frame rate, CFL, Δt bounds, gravity, transfer, kernel
 //   Grid        box, cell size, domain walls
-//   Newton      implicit::NewtonSettings
+//   Newton      newton::NewtonSettings
 //   Solver      the solver XML file
 //   Materials   one sublist per material: "Model" and that model's parameters
 //   Bodies      one sublist per body: shape, material, sampling, initial velocity
@@ -17,7 +17,7 @@
 
 #include "viscompm/core/parameters.hpp"
 #include "viscompm/core/shape.hpp"
-#include "viscompm/implicit/newton.hpp"
+#include "viscompm/newton/newton_settings.hpp"
 
 namespace viscompm::scene {
 
@@ -44,6 +44,8 @@ struct GridSettings {
   int wall_thickness = 2;
   std::string outside_particles = "clamp";
   double rebalance_threshold = 1.25;
+  int padding_cells = 0;
+  double padding_lookahead = 8.0;
   static const ParameterTable<GridSettings>& table();
 };
 
@@ -101,7 +103,7 @@ struct SceneConfig {
   std::string name;                  ///< the top-level list's name
   SimulationSettings simulation;
   GridSettings grid;
-  implicit::NewtonSettings newton;
+  newton::NewtonSettings newton;
   std::string solver_file;           ///< resolved path
   OutputSettings output;
   std::vector<MaterialSettings> materials;

@@ -30,6 +30,14 @@ struct RunSummary {
   std::int64_t newton_iterations = 0;
   std::int64_t linear_iterations = 0;
   std::int64_t retries = 0;
+  std::int64_t assemblies = 0;             ///< Hessians assembled (or matrix-free pieces prepared)
+  std::int64_t preconditioner_setups = 0;
+  double operator_seconds = 0.0;           ///< in assembly (or the matrix-free set-up), all solves
+  double preconditioner_seconds = 0.0;     ///< in preconditioner set-up
+  double cg_seconds = 0.0;                 ///< in CG
+  double line_search_seconds = 0.0;
+  std::int64_t graph_builds = 0;         ///< node partitions (and Hessian graphs) built, all steps
+  std::int64_t ghost_particle_steps = 0;  ///< Σ over steps of the global count of ghost particles
   std::int64_t particles_deleted = 0;
   std::int64_t particles_migrated = 0;  ///< sent between ranks, all steps
   std::int64_t shared_node_steps = 0;   ///< Σ over steps of the global count of ghost nodes
@@ -58,8 +66,9 @@ class Simulation {
   /// RunSummary::stop_signal set. A failed write (disk full, directory gone) is SimulationError;
   /// every file written before stays intact.
   RunSummary run(std::ostream& log);
-  /// Writes DIR/checkpoint_NNNNN.h5 for the current frame; returns its path.
-  std::string write_checkpoint() const;
+  /// Writes DIR/checkpoint_NNNNN.h5 for the current frame; returns its path. The run then
+  /// continues as one restarted from it would (TimeIntegrator::reset_reuse).
+  std::string write_checkpoint();
   /// Advances to time t_end with adaptive steps (no output). Throws SimulationError if a step
   /// fails at the smallest Δt. Inside run(), returns false when it stopped early on a request.
   bool advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr);
@@ -107,7 +116,8 @@ class Simulation {
   /// After a step inside run(): agrees on stop requests, wall-clock checkpoints and the solver
   /// log's health; true if the run must stop (its checkpoint written).
   bool stop_requested(RunSummary& summary, std::ostream* log);
-  std::string write_checkpoint_file(const std::string& name) const;
+  /// Writes DIR/NAME and resets the integrator's reuse, as write_checkpoint.
+  std::string write_checkpoint_file(const std::string& name);
   void write_frame(int frame);
 };
 

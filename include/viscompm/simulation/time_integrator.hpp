@@ -8,20 +8,29 @@
 
 #include "viscompm/boundary/colliders.hpp"
 #include "viscompm/grid/grid_layout.hpp"
-#include "viscompm/implicit/newton.hpp"
+#include "viscompm/newton/newton_solver.hpp"
 #include "viscompm/linalg/newton_system.hpp"
 #include "viscompm/linalg/node_space.hpp"
 #include "viscompm/materials/material.hpp"
 #include "viscompm/parallel/decomposition.hpp"
+#include "viscompm/parallel/node_partition.hpp"
 #include "viscompm/transfer/transfer.hpp"
 
 namespace viscompm::simulation {
 
+/// How far the node partition (the Hessian's graph) reaches beyond the occupied cells.
+struct PaddingSettings {
+  int margin = 0;              ///< cells around every occupied cell
+  double lookahead = 8.0;      ///< and further along each particle's velocity: this many steps
+  int max_padding = 8;         ///< cap on the velocity padding, in cells
+};
+
 struct IntegratorSettings {
   Vec3 gravity = Vec3::Zero();
+  PaddingSettings padding;
   bool delete_outside_particles = false;  ///< else clamp them to the last cell
   transfer::TransferSettings transfer;
-  implicit::NewtonSettings newton;
+  newton::NewtonSettings newton;
 };
 
 /// The objective of one step, built from the last p2g (valid until the next build_layout).
@@ -34,8 +43,9 @@ struct StepObjective {
 
 struct StepReport {
   double dt = 0.0;
-  implicit::NewtonReport newton;
-  bool graph_rebuilt = false;
+  newton::NewtonReport newton;
+  bool partition_rebuilt = false;   ///< the node partition (and the Hessian's graph) was built anew
+  std::size_t ghost_particles = 0;  ///< neighbours' particles copied here
   std::size_t particles_clamped = 0;
   std::size_t particles_deleted = 0;
   std::size_t particles_sent = 0;   ///< migrated to other ranks by this rank
@@ -56,23 +66,47 @@ class TimeIntegrator {
   StepReport step(particles::ParticleSet& particles, double t, double dt, const std::string& dump_prefix = "");
 
   // The phases of step(), public for tests and the solver study.
-  /// Sorts particles by cell and decides node ownership for this step.
-  void build_layout(particles::ParticleSet& particles);
-  /// Grid mass and velocity v^n, summed over ranks.
+  /// Sorts particles by cell, rebuilds the node partition if a particle left it (padding for
+  /// steps of `dt`), and appends the ghost particles to `particles` (drop_ghosts removes them).
+  /// Returns true if the partition was rebuilt.
+  bool build_layout(particles::ParticleSet& particles, double dt);
+  /// Drops what steps reuse (the node partition, the Hessian's graph, a kept Hessian and
+  /// preconditioner), as a run
+  /// restarted at this point starts: called after each checkpoint, so that restarts continue bit
+  /// for bit (the padding decides the vector lengths, and so the grouping of floating-point sums).
+  void reset_reuse() {
+    partition_.reset();
+    newton_.forget();
+  }
+  /// build_layout and particles_to_grid: what tests, benchmarks and the solver study need before
+  /// build_objective.
+  void prepare(particles::ParticleSet& particles, double dt) {
+    build_layout(particles, dt);
+    particles_to_grid(particles);
+  }
+  /// The first Newton right-hand side −∇E at the objective's initial guess, on the owned nodes
+  /// (zero on ghosts). False on every rank if the initial guess is infeasible (collective).
+  bool first_right_hand_side(const StepObjective& objective, NodeVectorField& rhs) const;
+  /// Removes the ghost particles build_layout appended.
+  void drop_ghosts(particles::ParticleSet& particles) const;
+  /// Grid mass and velocity v^n on the local nodes (complete on owned nodes, imported to ghosts).
   void particles_to_grid(const particles::ParticleSet& particles);
   /// E(v) of the step from t to t + dt.
   std::unique_ptr<StepObjective> build_objective(const particles::ParticleSet& particles, double t, double dt) const;
-  /// Particle velocities, affine velocities and strains from the solved grid velocities.
+  /// Velocities, affine velocities and strains of the own particles from the solved grid velocities.
   void grid_to_particles(particles::ParticleSet& particles, const NodeVectorField& v, double dt);
   /// Moves particles, keeps them in the grid, sends them to their new owners.
   void advect(particles::ParticleSet& particles, double dt, StepReport& report);
 
   const IntegratorSettings& settings() const { return settings_; }
-  /// Node ownership from now on (after rebalancing; the particles must be migrated to it).
+  /// Node ownership from now on (after rebalancing; the particles must be migrated to it). The
+  /// next step rebuilds the node partition.
   void set_decomposition(const parallel::Decomposition& decomposition) { decomposition_ = &decomposition; }
   const grid::GridLayout& layout() const { return layout_; }
   linalg::NewtonSystem& newton_system() { return system_; }
   linalg::NodeSpace& node_space() { return space_; }
+  /// How many times the node partition has been built.
+  int partition_builds() const { return partition_builds_; }
   /// Grid mass and velocity of the last p2g, on the layout's local nodes.
   const NodeScalarField& grid_mass() const { return mass_; }
   const NodeVectorField& grid_velocity() const { return v_old_; }
@@ -84,8 +118,12 @@ class TimeIntegrator {
   IntegratorSettings settings_;
   const materials::MaterialList& materials_;
   const boundary::Boundary& boundary_;
+  std::unique_ptr<parallel::NodePartition> partition_;
+  const parallel::Decomposition* partition_decomposition_ = nullptr;  // the decomposition it was built for
+  int partition_builds_ = 0;
   linalg::NodeSpace space_;
   linalg::NewtonSystem system_;
+  newton::NewtonSolver newton_;
   NodeScalarField mass_;
   NodeVectorField momentum_, v_old_;
 };

@@ -1,12 +1,19 @@
-// Preconditioner studies (viscompm-study, doc/contracts.md): the same Newton systems solved with
-// several solver configurations. A problem is the first Newton system of a scene's step at a
-// given cell size and Δt (after advancing the scene to a chosen time), or a MatrixMarket file.
-// Writes DIR/study.csv (one row per problem, resolution and configuration), DIR/operators.csv
-// (assembly and operator-application times) and DIR/study.png.
+// Solver studies (viscompm-study), in two modes.
+//
+// systems: the same Newton systems solved with several solver configurations. A problem is the
+//   first Newton system of a scene's step at a given cell size and Δt (after advancing the scene
+//   to a chosen time), or a MatrixMarket file. Writes DIR/study.csv (one row per problem,
+//   resolution and configuration; time to solution = operator_seconds + setup_seconds +
+//   solve_seconds), DIR/operators.csv (operator preparation and application) and DIR/study.png.
+// steps: whole frames of a scene, once per configuration (a solver file and Newton settings),
+//   to the same Newton tolerance. Writes DIR/steps.csv (iterations, wall time and where it went)
+//   and DIR/steps.png.
+// doc/inputs.md lists the parameters; doc/contracts.md the CSV columns.
 #pragma once
 
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "viscompm/core/parameters.hpp"
 #include "viscompm/parallel/communicator.hpp"
@@ -15,17 +22,28 @@
 namespace viscompm::study {
 
 struct StudySettings {
+  std::string mode = "systems";       ///< systems | steps
   std::string scene;                  ///< scene XML, relative to the study file
-  RealList cell_sizes;                ///< resolutions Δx [m]
-  RealList time_steps;                ///< Δt, in `time_step_unit`
+  RealList cell_sizes;                ///< resolutions Δx [m] (systems)
+  RealList time_steps;                ///< Δt, in `time_step_unit` (systems)
   std::string time_step_unit = "elastic CFL";
-  double time = 0.0;                  ///< advance the scene to this time first [s]
-  std::string right_hand_side = "newton";  ///< newton: −∇E; random: a fixed random load
+  double time = 0.0;                  ///< advance the scene to this time first [s] (systems)
+  std::string right_hand_side = "newton";  ///< newton: −∇E; random: a fixed random load (systems)
   StringList solvers;                 ///< solver XML files, relative to the study file
-  StringList matrix_market_files;     ///< extra problems, relative to the study file
+  StringList matrix_market_files;     ///< extra problems, relative to the study file (systems)
   int repetitions = 1;                ///< solves per (problem, configuration); the fastest is kept
+  int frames = 2;                     ///< frames per configuration (steps)
+  StringList scene_overrides;         ///< "Path/To/Parameter=value" applied to the scene (steps)
   std::string output_directory = "output/study";
   bool plot = true;
+
+  /// A configuration of the steps mode: a solver file and overrides of the scene's Newton list.
+  struct Configuration {
+    std::string label;
+    std::string solver;               ///< resolved path
+    StringList newton;                ///< "Parameter=value" in the scene's Newton list
+  };
+  std::vector<Configuration> configurations;  ///< the "Configurations" sublist, else one per solver
 
   static const ParameterTable<StudySettings>& table();
 };
