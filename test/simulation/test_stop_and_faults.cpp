@@ -1,6 +1,6 @@
 // A run stopped by a signal that reaches one rank only stops on every rank after the same step,
-// with a checkpoint from which --restart continues bit for bit; wall-clock checkpoints replace
-// each other; a step that goes non-finite is retried with a smaller Δt and, when that cannot
+// with a checkpoint from which --restart continues bit for bit (like a run that wrote a
+// checkpoint there and went on); wall-clock checkpoints replace each other; a step that goes non-finite is retried with a smaller Δt and, when that cannot
 // help, ends the run with SimulationError and the frames written so far intact.
 #include <gtest/gtest.h>
 
@@ -88,7 +88,14 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   const auto solver = testkit::jacobi_cg(1e-12);
   std::ostringstream log;
 
-  simulation::Simulation straight(short_run(dir + "/straight"), solver, world);
+  // A checkpoint resets what the solver reuses across steps, as a restart starts afresh: the
+  // reference writes one after every step (wall-clock checkpoints every 1e-9 s), and so does the
+  // run that is stopped and restarted.
+  auto every_step = [](scene::SceneConfig scene) {
+    scene.output.checkpoint_wall_seconds = 1e-9;
+    return scene;
+  };
+  simulation::Simulation straight(every_step(short_run(dir + "/straight")), solver, world);
   const auto done = straight.run(log);
   EXPECT_EQ(done.stop_signal, 0);
   const auto reference = testkit::gather_particles(straight.particles(), world.comm());
@@ -97,7 +104,7 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   simulation::install_stop_handlers();
   simulation::clear_stop_signal();
   if (world.rank() == world.size() - 1) std::raise(SIGTERM);
-  simulation::Simulation stopped(short_run(dir + "/stopped"), solver, world);
+  simulation::Simulation stopped(every_step(short_run(dir + "/stopped")), solver, world);
   const auto summary = stopped.run(log);
   simulation::clear_stop_signal();
   EXPECT_EQ(summary.stop_signal, SIGTERM);
@@ -107,7 +114,7 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   EXPECT_LT(stopped.time(), 1.0 / 120.0) << "stopped inside frame 1";
   EXPECT_TRUE(files_starting_with(dir + "/stopped", "frame_00001").empty());
 
-  simulation::Simulation continued(short_run(dir + "/stopped"), solver, world, summary.stop_checkpoint);
+  simulation::Simulation continued(every_step(short_run(dir + "/stopped")), solver, world, summary.stop_checkpoint);
   EXPECT_EQ(continued.time(), stopped.time());
   const auto rest = continued.run(log);
   EXPECT_EQ(rest.stop_signal, 0);
