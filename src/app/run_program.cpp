@@ -67,7 +67,8 @@ int run_simulation_program(int argc, char** argv) {
       std::cout << "done: " << summary.steps << " steps, " << summary.newton_iterations << " Newton iterations, "
                 << summary.linear_iterations << " CG iterations, " << summary.retries << " retries in "
                 << summary.wall_seconds << " s\n"
-                << "graph builds: " << summary.graph_builds << " in " << summary.steps << " steps ("
+                << "assemblies: " << summary.assemblies << ", preconditioner set-ups: " << summary.preconditioner_setups
+                << "; graph builds: " << summary.graph_builds << " in " << summary.steps << " steps ("
                 << double(summary.graph_builds) / std::max<std::int64_t>(summary.steps, 1) << " per step)\n"
                 << "per step: " << summary.owned_node_steps / std::max<std::int64_t>(summary.steps, 1)
                 << " grid nodes, " << summary.shared_node_steps / std::max<std::int64_t>(summary.steps, 1)

@@ -37,8 +37,9 @@ LinearSolveReport KrylovSolver::solve(const Teuchos::RCP<const operator_type>& A
   const auto start = std::chrono::steady_clock::now();
   try {
     report.converged = solver_->solve() == Belos::Converged;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
     report.converged = false;  // breakdown (e.g. an indefinite operator)
+    report.failure = e.what();
   }
   report.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.iterations = solver_->getNumIters();

@@ -23,7 +23,15 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
                 "Belos solver (Pseudo Block CG is Belos' CG)")
         .string(&S::preconditioner, "Preconditioner", "Ifpack2", {"none", "Jacobi", "Ifpack2", "MueLu"},
                 "none; Jacobi (exact diagonal of H, also matrix-free); Ifpack2 or MueLu (assembled only)")
-        .string(&S::ifpack2_type, "Ifpack2 type", "RELAXATION", {}, "Ifpack2::Factory name (RELAXATION, CHEBYSHEV, ...)");
+        .string(&S::ifpack2_type, "Ifpack2 type", "RELAXATION", {}, "Ifpack2::Factory name (RELAXATION, CHEBYSHEV, ...)")
+        .string(&S::prolongation, "Prolongation", "algebraic", {"algebraic", "trilinear", "quadratic B-spline"},
+                "MueLu: the prolongators of its own aggregation (algebraic), or geometric ones between the grids "
+                "Δx, 2Δx, 4Δx, ... (trilinear, or the coarse quadratic B-spline at the fine nodes)")
+        .integer(&S::coarsest_nodes, "Coarsest nodes", 2000, Range::at_least(1),
+                 "geometric prolongation: coarsen until a level has at most this many nodes")
+        .string(&S::near_nullspace, "Near nullspace", "rigid body modes", {"rigid body modes", "translations"},
+                "algebraic MueLu: the modes its aggregates must represent (the 6 rigid-body modes, or the 3 "
+                "translations, for aggregates of a node or two)");
     return table;
   }();
   return t;
@@ -62,6 +70,8 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   if ((s.preconditioner == "none" || s.preconditioner == "Jacobi") && impl->preconditioner_parameters->numParams() > 0)
     throw InputError(origin + ": parameter '" + preconditioner_sublist + "': " + s.preconditioner +
                      " takes no parameters");
+  if (s.prolongation != "algebraic" && s.preconditioner != "MueLu")
+    throw InputError(origin + ": parameter 'Prolongation': geometric prolongators are for Preconditioner = MueLu");
   if (s.label.empty()) {
     s.label = (s.operator_form == "matrix-free" ? "matrix-free " : "") +
               (s.preconditioner == "Ifpack2" ? "Ifpack2 " + s.ifpack2_type : s.preconditioner);

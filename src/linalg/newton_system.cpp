@@ -46,6 +46,12 @@ void NewtonSystem::Impl::build_near_nullspace() {
     }
   }
   modes.rigid_body_modes = rigid_body_modes(*modes.coordinates, s.owned_dof_map);
+  auto grid = std::make_shared<SystemGrid>();
+  grid->dimensions = partition.geometry().nodes();
+  for (std::size_t i = 0; i < partition.owned_count(); ++i)
+    grid->owned_nodes.push_back(partition.geometry().node_index(partition.nodes()[i]));
+  grid->owner = [&partition](const Int3& ijk) { return partition.grid_owner(ijk); };
+  modes.grid = grid;
 }
 
 void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
@@ -102,6 +108,31 @@ double NewtonSystem::precondition() {
 }
 
 bool NewtonSystem::preconditioned() const { return impl_->preconditioned; }
+
+std::vector<std::int64_t> NewtonSystem::preconditioner_levels() const { return impl_->preconditioner->level_rows(); }
+
+std::vector<std::tuple<long long, long long, double>> NewtonSystem::preconditioner_level_entries(int level) const {
+  const auto A = impl_->preconditioner->level_matrix(level);
+  std::vector<double> local;  // (row, column, value) triplets by global ids
+  if (!A.is_null()) {
+    const auto rows = A->getRowMap();
+    const auto columns = A->getColMap();
+    for (std::size_t r = 0; r < A->getNodeNumRows(); ++r) {
+      crs_matrix_type::local_inds_host_view_type cols;
+      crs_matrix_type::values_host_view_type vals;
+      A->getLocalRowView(static_cast<local_ordinal_type>(r), cols, vals);
+      for (std::size_t k = 0; k < cols.extent(0); ++k)
+        local.insert(local.end(), {double(rows->getGlobalElement(static_cast<local_ordinal_type>(r))),
+                                   double(columns->getGlobalElement(cols(k))), vals(k)});
+    }
+  }
+  const auto all = impl_->space.comm().all_gather(local);
+  std::vector<std::tuple<long long, long long, double>> entries;
+  for (std::size_t k = 0; k + 2 < all.size(); k += 3)
+    entries.emplace_back(static_cast<long long>(all[k]), static_cast<long long>(all[k + 1]), all[k + 2]);
+  std::sort(entries.begin(), entries.end());
+  return entries;
+}
 
 std::uint64_t NewtonSystem::pattern_version() const { return impl_->pattern_version; }
 

@@ -1,10 +1,15 @@
-// The preconditioners: none, Ifpack2 (any Ifpack2::Factory type) and MueLu smoothed
-// aggregation with coordinates and rigid-body near-nullspace in its "user data".
+// The preconditioners: none, Jacobi, Ifpack2 (any Ifpack2::Factory type) and MueLu: algebraic
+// (aggregation, with coordinates and the rigid-body near-nullspace in its "user data") or on
+// geometric prolongators between the grids Δx, 2Δx, 4Δx, ... (parallel/grid_hierarchy) that MueLu
+// takes as each level's P, forming the Galerkin products and smoothers itself.
 #include <Ifpack2_Factory.hpp>
 #include <MueLu_CreateTpetraPreconditioner.hpp>
+#include <MueLu_HierarchyUtils.hpp>
+#include <MueLu_ParameterListInterpreter.hpp>
 
 #include "krylov.hpp"
 #include "viscompm/core/error.hpp"
+#include "viscompm/parallel/grid_hierarchy.hpp"
 
 namespace viscompm::linalg {
 
@@ -66,8 +71,7 @@ class Ifpack2Preconditioner : public Preconditioner {
   void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace&) override {
     const Teuchos::RCP<crs_matrix_type> A = H.matrix();
     if (pattern_changed || prec_.is_null()) {
-      prec_ = Ifpack2::Factory::create<Tpetra::RowMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>>(
-          config_.impl().settings.ifpack2_type, A);
+      prec_ = Ifpack2::Factory::create<row_matrix_type>(config_.impl().settings.ifpack2_type, A);
       if (prec_.is_null())
         throw InputError(config_.origin() + ": parameter 'Ifpack2 type': unknown Ifpack2 preconditioner '" +
                          config_.impl().settings.ifpack2_type + "'");
@@ -84,8 +88,46 @@ class Ifpack2Preconditioner : public Preconditioner {
 
  private:
   SolverConfiguration config_;
-  Teuchos::RCP<Ifpack2::Preconditioner<scalar_type, local_ordinal_type, global_ordinal_type, node_type>> prec_;
+  Teuchos::RCP<ifpack2_preconditioner_type> prec_;
 };
+
+// P of one coarse level: rows = the finer level's owned dofs, columns = this level's owned and
+// ghost dofs; weight × I₃ per (fine node, coarse node). Built from local arrays.
+Teuchos::RCP<crs_matrix_type> make_prolongator(const parallel::CoarseLevel& c, const Teuchos::RCP<const map_type>& fine_dofs,
+                                               Teuchos::RCP<const map_type>& coarse_dofs) {
+  using row_map_view = crs_matrix_type::local_graph_device_type::row_map_type::non_const_type;
+  using entries_view = crs_matrix_type::local_graph_device_type::entries_type::non_const_type;
+  using values_view = crs_matrix_type::local_matrix_device_type::values_type;
+  const auto comm = fine_dofs->getComm();
+  coarse_dofs = Teuchos::rcp(new map_type(3 * c.global_count, 3 * c.owned_count, 0, comm));
+  std::vector<global_ordinal_type> column_gids(3 * c.nodes.size());
+  for (std::size_t k = 0; k < c.nodes.size(); ++k)
+    for (int d = 0; d < 3; ++d) column_gids[3 * k + d] = 3 * c.system_ids[k] + d;
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  const Teuchos::RCP<const map_type> columns =
+      Teuchos::rcp(new map_type(invalid, Teuchos::ArrayView<const global_ordinal_type>(column_gids), 0, comm));
+  const std::size_t fine_nodes = c.row_begin.size() - 1;
+  row_map_view offsets("P offsets", 3 * fine_nodes + 1);
+  entries_view indices("P columns", 3 * c.columns.size());
+  values_view values("P values", 3 * c.columns.size());
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < fine_nodes; ++i)
+    for (int d = 0; d < 3; ++d) {
+      offsets(3 * i + d) = at;
+      for (std::size_t k = c.row_begin[i]; k < c.row_begin[i + 1]; ++k, ++at) {
+        indices(at) = 3 * c.columns[k] + d;
+        values(at) = c.weights[k];
+      }
+    }
+  offsets(3 * fine_nodes) = at;
+  Teuchos::Array<int> owners(3 * c.ghost_owners.size());
+  for (std::size_t g = 0; g < c.ghost_owners.size(); ++g)
+    for (int d = 0; d < 3; ++d) owners[3 * g + d] = c.ghost_owners[g];
+  const auto importer = Teuchos::rcp(new import_type(coarse_dofs, columns, owners));
+  auto P = Teuchos::rcp(new crs_matrix_type(fine_dofs, columns, offsets, indices, values));
+  P->expertStaticFillComplete(coarse_dofs, fine_dofs, importer);
+  return P;
+}
 
 class MueLuPreconditioner : public Preconditioner {
  public:
@@ -98,22 +140,85 @@ class MueLuPreconditioner : public Preconditioner {
       return;
     }
     Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
+    if (!params.isParameter("number of equations")) params.set("number of equations", 3);
+    if (config_.impl().settings.prolongation == "algebraic") setup_algebraic(A, params, modes);
+    else setup_geometric(A, params, modes);
+  }
+  Teuchos::RCP<operator_type> op() const override { return prec_; }
+  Teuchos::RCP<const crs_matrix_type> level_matrix(int level) const override {
+    if (prec_.is_null() || level >= prec_->GetHierarchy()->GetNumLevels()) return Teuchos::null;
+    const auto A = prec_->GetHierarchy()->GetLevel(level)->template Get<Teuchos::RCP<xpetra_matrix_type>>("A");
+    return muelu_utilities_type::Op2TpetraCrs(A);
+  }
+  std::vector<std::int64_t> level_rows() const override {
+    std::vector<std::int64_t> rows;
+    if (prec_.is_null()) return rows;
+    const auto hierarchy = prec_->GetHierarchy();
+    for (int level = 0; level < hierarchy->GetNumLevels(); ++level)
+      rows.push_back(static_cast<std::int64_t>(
+          hierarchy->GetLevel(level)->template Get<Teuchos::RCP<xpetra_matrix_type>>("A")->getGlobalNumRows()));
+    return rows;
+  }
+
+ private:
+  void setup_algebraic(const Teuchos::RCP<crs_matrix_type>& A, Teuchos::ParameterList& params,
+                       const NearNullspace& modes) {
     Teuchos::ParameterList& user = params.sublist("user data");
     if (!modes.coordinates.is_null()) user.set("Coordinates", modes.coordinates);
-    if (!modes.rigid_body_modes.is_null()) user.set("Nullspace", modes.rigid_body_modes);
-    if (!params.isParameter("number of equations")) params.set("number of equations", 3);
+    if (!modes.rigid_body_modes.is_null()) {
+      if (config_.impl().settings.near_nullspace == "translations") {
+        Teuchos::RCP<multivector_type> translations = modes.rigid_body_modes->subCopy(Teuchos::Range1D(0, 2));
+        user.set("Nullspace", translations);
+      } else {
+        user.set("Nullspace", modes.rigid_body_modes);
+      }
+    }
     // A hierarchy of one level would hand the whole (distributed) matrix to the coarse direct
-    // solver, which is wrong on more than one rank here (DESIGN.md §5): always coarsen once, so
-    // that the coarse level goes through repartitioning.
+    // solver, which is wrong on more than one rank here (doc/trilinos.md): always coarsen once,
+    // so that the coarse level goes through repartitioning.
     const auto rows = static_cast<int>(A->getGlobalNumRows());
     if (rows <= params.get<int>("coarse: max size", 2000)) params.set("coarse: max size", std::max(1, rows / 8));
     prec_ = MueLu::CreateTpetraPreconditioner(Teuchos::rcp_static_cast<operator_type>(A), params);
   }
-  Teuchos::RCP<operator_type> op() const override { return prec_; }
 
- private:
+  // The grids 2Δx, 4Δx, ... as MueLu's levels: each level's P in its "level N" sublist. MueLu's
+  // CreateTpetraPreconditioner hands its interpreter the list without the non-serialisable P,
+  // which then aggregates anyway; built as below, the interpreter sees the P and uses it.
+  void setup_geometric(const Teuchos::RCP<crs_matrix_type>& A, Teuchos::ParameterList& params,
+                       const NearNullspace& modes) {
+    if (!modes.grid) throw InputError(config_.origin() + ": parameter 'Prolongation': geometric prolongators need the "
+                                      "grid of the system (a scene, or a MatrixMarket dump with node coordinates)");
+    const auto comm = A->getRowMap()->getComm();
+    const parallel::Communicator communicator(*Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm)->getRawMpiComm());
+    parallel::HierarchySettings settings;
+    settings.prolongation = config_.impl().settings.prolongation == "trilinear" ? parallel::Prolongation::trilinear
+                                                                                 : parallel::Prolongation::quadratic_bspline;
+    settings.max_levels = params.get<int>("max levels", 10);
+    settings.coarsest_nodes = config_.impl().settings.coarsest_nodes;
+    const auto levels = parallel::build_grid_hierarchy(communicator, modes.grid->dimensions, modes.grid->owned_nodes,
+                                                       modes.grid->owner, settings);
+    Teuchos::RCP<const map_type> fine = A->getRowMap();
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+      Teuchos::RCP<const map_type> coarse;
+      const auto P = make_prolongator(levels[l], fine, coarse);
+      params.sublist("level " + std::to_string(l + 1)).set("P", MueLu::TpetraCrs_To_XpetraMatrix(P));
+      fine = coarse;
+    }
+    params.set("max levels", static_cast<int>(levels.size()) + 1);
+    params.set("coarse: max size", 1);
+    Teuchos::ParameterList serializable, non_serializable;
+    MueLu::ExtractNonSerializableData(params, serializable, non_serializable);
+    muelu_interpreter_type interpreter(params, comm);
+    Teuchos::RCP<muelu_hierarchy_type> hierarchy = interpreter.CreateHierarchy();
+    hierarchy->setlib(Xpetra::UseTpetra);
+    muelu_hierarchy_utils_type::AddNonSerializableDataToHierarchy(interpreter, *hierarchy, non_serializable);
+    hierarchy->GetLevel(0)->Set("A", MueLu::TpetraCrs_To_XpetraMatrix(A));
+    interpreter.SetupHierarchy(*hierarchy);
+    prec_ = Teuchos::rcp(new muelu_operator_type(hierarchy));
+  }
+
   SolverConfiguration config_;
-  Teuchos::RCP<MueLu::TpetraOperator<scalar_type, local_ordinal_type, global_ordinal_type, node_type>> prec_;
+  Teuchos::RCP<muelu_operator_type> prec_;
 };
 }  // namespace
 

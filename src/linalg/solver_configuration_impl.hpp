@@ -15,6 +15,9 @@ struct SolverSettings {
   std::string krylov_solver = "Pseudo Block CG";
   std::string preconditioner = "Ifpack2";
   std::string ifpack2_type = "RELAXATION";
+  std::string prolongation = "algebraic";
+  int coarsest_nodes = 2000;
+  std::string near_nullspace = "rigid body modes";
 
   static const ParameterTable<SolverSettings>& table();
 };

@@ -86,6 +86,8 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
   if (settings_.hessian_update != HessianUpdate::lagged || system_.matrix_free() ||
       kept_pattern_ != system_.pattern_version() || kept_dt_ != potential.dt())
     hessian_kept_ = false;
+  // A preconditioner of another Δt's H (H = M + Δt² K) is refreshed.
+  if (preconditioner_dt_ != potential.dt()) refresh_preconditioner_ = true;
   NodeVectorField g, dv;
   for (;;) {
     // Residual: g = ∇E(v), complete on the owned nodes.
@@ -168,6 +170,7 @@ void NewtonSolver::assemble(Step& step, bool project) {
     Teuchos::TimeMonitor t(precondition_timer());
     step.report.linear_solves.back().setup_seconds = system_.precondition();
     ++step.report.preconditioner_setups;
+    preconditioner_dt_ = step.potential.dt();
     preconditioner_baseline_cg_ = -1;
     refresh_preconditioner_ = false;
     step.preconditioned_this_step = true;
@@ -215,9 +218,13 @@ bool NewtonSolver::direction_and_line_search(Step& step, const NodeVectorField& 
     const double slope = -owned_dot(rhs, dv, owned, comm_);  // ∇E·dv
     const bool usable = slope < 0.0 && (solve.converged || used_projection || !may_project);
     if (usable && line_search(step, dv, slope)) return true;
-    // A kept H that failed is replaced by a fresh one; a fresh exact one by the projected one.
-    if (!fresh) {
+    // A kept H or preconditioner that failed is replaced by a fresh one; a fresh exact H by the
+    // projected one.
+    const bool preconditioner_kept =
+        solve.setup_seconds == 0.0 && settings_.preconditioner_update != PreconditionerUpdate::every_assembly;
+    if (!fresh || preconditioner_kept) {
       fresh = true;
+      refresh_preconditioner_ = true;
       project = settings_.hessian_projection == HessianProjection::always;
       continue;
     }

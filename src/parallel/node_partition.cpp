@@ -23,7 +23,7 @@ void for_each_node(const Int3& lower, const Int3& upper, F&& f) {
 
 NodePartition::NodePartition(const Communicator& comm, const grid::GridGeometry& geometry, grid::KernelOrder order,
                              const Decomposition& decomposition, const std::vector<PaddedCell>& own_cells)
-    : geometry_(geometry), order_(order), rank_(comm.rank()) {
+    : geometry_(geometry), order_(order), decomposition_(&decomposition), rank_(comm.rank()) {
   window_radius_ = grid::stencil_width(order) - 1;
   const int width = 2 * window_radius_ + 1;
   window_size_ = width * width * width;

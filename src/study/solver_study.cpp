@@ -126,6 +126,7 @@ void log_row(std::ostream& log, const Row& row) {
       << " operator=" << std::setprecision(3) << r.operator_seconds << "s setup=" << r.setup_seconds
       << "s solve=" << r.solve_seconds << "s" << (r.converged ? "" : "  NOT CONVERGED") << std::setprecision(6)
       << std::endl;
+  if (!r.failure.empty()) log << "  " << r.failure.substr(0, r.failure.find('\n')) << std::endl;
 }
 
 // The first Newton system of a scene at each cell size and Δt, under every configuration. Each

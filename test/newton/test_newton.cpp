@@ -82,12 +82,13 @@ struct StrategyRun {
 };
 
 // The default scene, coarse, for a few steps through the bullet's impact, with `settings`.
-StrategyRun run_sponge(const std::vector<scene::Override>& newton_settings) {
+StrategyRun run_sponge(const std::vector<scene::Override>& newton_settings, const std::string& solver_file = "") {
   std::vector<scene::Override> overrides = {{"Grid/Cell size", "0.06"}, {"Newton/Tolerance", "1e-7"}};
   overrides.insert(overrides.end(), newton_settings.begin(), newton_settings.end());
   const auto scene = scene::read_scene(VISCOMPM_SOURCE_DIR "/inputs/scenes/shooting_sponge.xml", overrides);
   const parallel::Communicator comm(MPI_COMM_WORLD);
-  simulation::Simulation sim(scene, linalg::SolverConfiguration::read(scene.solver_file), comm);
+  simulation::Simulation sim(scene, linalg::SolverConfiguration::read(solver_file.empty() ? scene.solver_file : solver_file),
+                             comm);
   StrategyRun run;
   simulation::RunSummary summary;
   sim.advance_to(0.06, summary);
@@ -120,5 +121,15 @@ TEST(Newton, EveryStrategyReachesTheStateOfExactNewtonWithLessWork) {
     if (c.name == "inexact Newton") EXPECT_LT(run.cg_iterations, exact.cg_iterations) << c.name;
     else if (c.name == "lagged preconditioner") EXPECT_LT(run.setups, exact.setups) << c.name;
     else EXPECT_LT(run.assemblies, exact.assemblies) << c.name;
+  }
+}
+
+TEST(Newton, AHierarchyReusedAcrossIterationsAndStepsReachesTheStateOfAFreshOne) {
+  const std::string gmg = VISCOMPM_SOURCE_DIR "/inputs/solvers/gmg_cg.xml";
+  const StrategyRun fresh = run_sponge({}, gmg);
+  for (const char* update : {"every step", "lagged"}) {
+    const StrategyRun reused = run_sponge({{"Newton/Preconditioner update", update}}, gmg);
+    EXPECT_LT(testkit::max_state_difference(fresh.state, reused.state), 1e-5) << update;
+    EXPECT_LT(reused.setups, fresh.setups) << update;
   }
 }

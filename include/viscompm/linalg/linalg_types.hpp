@@ -3,7 +3,15 @@
 // other file repeats them. Include only from src/linalg (Trilinos headers are slow to compile).
 #pragma once
 
+#include <Ifpack2_Preconditioner.hpp>
+#include <MueLu_HierarchyUtils_fwd.hpp>
+#include <MueLu_Hierarchy_fwd.hpp>
+#include <MueLu_ParameterListInterpreter_fwd.hpp>
+#include <MueLu_Utilities_fwd.hpp>
+#include <MueLu_TpetraOperator_fwd.hpp>
 #include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_RowMatrix_fwd.hpp>
+#include <Xpetra_Matrix_fwd.hpp>
 #include <Tpetra_Export.hpp>
 #include <Tpetra_FECrsGraph.hpp>
 #include <Tpetra_FECrsMatrix.hpp>
@@ -30,6 +38,16 @@ using crs_graph_type = Tpetra::CrsGraph<local_ordinal_type, global_ordinal_type,
 using crs_matrix_type = Tpetra::CrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 using fe_graph_type = Tpetra::FECrsGraph<local_ordinal_type, global_ordinal_type, node_type>;
 using fe_matrix_type = Tpetra::FECrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using row_matrix_type = Tpetra::RowMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using ifpack2_preconditioner_type =
+    Ifpack2::Preconditioner<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using xpetra_matrix_type = Xpetra::Matrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_hierarchy_type = MueLu::Hierarchy<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_operator_type = MueLu::TpetraOperator<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_interpreter_type =
+    MueLu::ParameterListInterpreter<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_hierarchy_utils_type = MueLu::HierarchyUtils<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_utilities_type = MueLu::Utilities<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 
 static_assert(std::is_same_v<global_ordinal_type, map_type::global_ordinal_type>);
 

@@ -18,6 +18,7 @@ struct LinearSolveReport {
   double tolerance = 0.0;          ///< the relative residual CG had to reach
   bool converged = false;
   std::string preconditioner;      ///< the configuration's label
+  std::string failure;             ///< why the Krylov solver stopped early (empty if it did not throw)
 };
 
 class SolverConfiguration {

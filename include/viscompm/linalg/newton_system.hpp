@@ -43,6 +43,11 @@ class NewtonSystem {
   /// with the last preconditioner (set up first if there is none); rhs on the owned nodes, dv
   /// returned on all local nodes.
   LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance = 0.0);
+  /// Global rows of each level of a multigrid preconditioner, finest first (empty otherwise).
+  std::vector<std::int64_t> preconditioner_levels() const;
+  /// Every entry of level `level` of a multigrid preconditioner as (row, column, value) in that
+  /// level's system dof ids (3 · node system id + d), on every rank, sorted (collective).
+  std::vector<std::tuple<long long, long long, double>> preconditioner_level_entries(int level) const;
   /// The solver file's relative CG tolerance.
   double default_tolerance() const;
 

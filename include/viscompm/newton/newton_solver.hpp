@@ -75,6 +75,7 @@ class NewtonSolver {
   std::uint64_t kept_pattern_ = 0;
   int hessian_baseline_cg_ = -1;        // CG iterations of the first solve after the last assembly
   int preconditioner_baseline_cg_ = -1; // ... after the last preconditioner set-up
+  double preconditioner_dt_ = 0.0;      // the Δt of the H the preconditioner was set up for
   bool refresh_hessian_ = false;
   bool refresh_preconditioner_ = false;
 };

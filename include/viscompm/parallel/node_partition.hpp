@@ -77,6 +77,9 @@ class NodePartition {
   int local_index(const Int3& ijk) const { return local_index_.get(ijk, -1); }
   /// Owner of node ijk; ijk must lie within reach of an owned node (window radius).
   int owner(const Int3& ijk) const;
+  /// Owner of any grid node by the decomposition the partition was built for (valid while that
+  /// decomposition lives: a new decomposition means a new partition).
+  int grid_owner(const Int3& ijk) const { return decomposition_->owner_of_node(ijk); }
 
   /// Window radius R: the columns of node i are the nodes j with |j − i|_∞ ≤ R.
   int window_radius() const { return window_radius_; }
@@ -107,6 +110,7 @@ class NodePartition {
 
   grid::GridGeometry geometry_;
   grid::KernelOrder order_;
+  const Decomposition* decomposition_;
   int rank_ = 0;
   int window_radius_ = 2;
   int window_size_ = 125;
