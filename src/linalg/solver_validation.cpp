@@ -218,9 +218,15 @@ void validate_muelu_parameters(const Teuchos::ParameterList& given, const std::s
     const std::string type = given.get<std::string>(type_name_parameter);
     const bool coarse = type_name_parameter == "coarse: type";
     if (Ifpack2::Factory::isSupported<crs_matrix_type>(type)) {
-      const Teuchos::ParameterList empty;
-      validate_ifpack2_parameters(type, given.isSublist(params_name) ? given.sublist(params_name) : empty, origin,
-                                  joined(path, type_name_parameter), joined(path, params_name));
+      // MueLu's Ifpack2 smoother takes a few keys out of the list before Ifpack2 sees it
+      // (MueLu_Ifpack2Smoother_def.hpp, Trilinos 13.2; MueLu does not list them anywhere).
+      Teuchos::ParameterList ifpack2_list = given.isSublist(params_name) ? given.sublist(params_name) : Teuchos::ParameterList();
+      for (const char* muelu_key : {"smoother: use blockcrsmatrix storage", "smoother: neighborhood type",
+                                    "pcoarsen: hi basis", "chebyshev: use rowsumabs diagonal scaling",
+                                    "chebyshev: rowsumabs diagonal replacement tolerance",
+                                    "chebyshev: rowsumabs diagonal replacement value"})
+        ifpack2_list.remove(muelu_key, false);
+      validate_ifpack2_parameters(type, ifpack2_list, origin, joined(path, type_name_parameter), joined(path, params_name));
     } else if (!(coarse && Amesos2::query(type))) {
       fail(origin, joined(path, type_name_parameter),
            "'" + type + "' is not an Ifpack2 preconditioner" + (coarse ? " or an Amesos2 solver" : "") +
