@@ -11,46 +11,17 @@
 #include <string>
 #include <vector>
 
+#include "model_variants.hpp"  // test/support
 #include "viscompm/materials/registry.hpp"
 
 using namespace viscompm;
 using namespace viscompm::materials;
 
 namespace {
-struct Variant {
-  std::string label;
-  std::string model;
-  std::vector<std::pair<std::string, ParameterValue>> values;
-};
+// The variants the derivative tests check, at the sponge's moduli (Table 5.2: μ = 360, λ = 1400).
+std::vector<testkit::ModelVariant> variants() { return testkit::model_variants(100.0); }
 
-std::vector<Variant> variants() {
-  const std::vector<std::pair<std::string, ParameterValue>> elastic = {
-      {"Density", 1.0}, {"Shear modulus", 360.0}, {"Lame lambda", 1400.0}};
-  auto with = [&](std::vector<std::pair<std::string, ParameterValue>> extra) {
-    auto v = elastic;
-    v.insert(v.end(), extra.begin(), extra.end());
-    return v;
-  };
-  return {
-      {"oldroyd_b (paper, 5.14)", "oldroyd_b", with({{"Strain update", std::string("paper")}, {"Newtonian viscosity", 0.1}})},
-      {"oldroyd_b (spd, §4.6.1)", "oldroyd_b", with({{"Strain update", std::string("spd")}, {"Newtonian viscosity", 0.1}})},
-      {"oldroyd_b (f_e, §4.7.1)", "oldroyd_b", with({{"Strain update", std::string("f_e")}, {"Newtonian viscosity", 0.1}})},
-      {"herschel_bulkley (h = 0.5)", "herschel_bulkley",
-       with({{"Yield stress", 0.05}, {"Plastic viscosity", 0.5}, {"Flow index", 0.5}, {"Newtonian viscosity", 0.1}})},
-      {"bingham", "bingham", with({{"Yield stress", 0.05}, {"Plastic viscosity", 0.5}, {"Newtonian viscosity", 0.1}})},
-      {"neo_hookean", "neo_hookean", elastic},
-      {"svd_plasticity", "svd_plasticity", with({{"Hardening coefficient", 10.0}})},
-      {"von_mises", "von_mises", with({{"Yield stress", 20.0}, {"Hardening modulus", 100.0}})},
-  };
-}
-
-std::unique_ptr<Material> build(const Variant& v) {
-  const ModelEntry* entry = find_model(v.model);
-  ParameterValues values;
-  for (const auto& spec : entry->parameters) values.set(spec.name, spec.default_value);
-  for (const auto& [name, value] : v.values) values.set(name, value);
-  return entry->create("bench", values);
-}
+std::unique_ptr<Material> build(const testkit::ModelVariant& v) { return testkit::build_material(v, "bench"); }
 
 Mat3 random_matrix(std::mt19937& rng, double scale) {
   std::uniform_real_distribution<double> u(-scale, scale);

@@ -7,12 +7,13 @@ OUT="${1:-$ROOT/output/bench}"
 BIN="$ROOT/build/bin"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 mkdir -p "$OUT"
-cmake --build "$ROOT/build" --target bench_spmv viscompm_app viscompm_study_app -j "$(nproc)" >/dev/null
+cmake --build "$ROOT/build" --target bench_operator viscompm_app viscompm_study_app -j "$(nproc)" >/dev/null
 lscpu > "$OUT/lscpu.txt"
 
-# 1. SpMV bandwidth against a triad; assembly against a matrix-free Hessian-vector product.
+# 1. The operator: graph build, values assembly (particle Hessians, elements), matrix-free set-up
+#    and product, SpMV against a triad.
 for n in 1 2; do
-  mpiexec -np $n "$BIN/bench_spmv" "$ROOT/inputs/scenes/shooting_sponge.xml" 0.01 100 | tee "$OUT/spmv_np$n.txt"
+  mpiexec -np $n "$BIN/bench_operator" "$ROOT/inputs/scenes/shooting_sponge.xml" 0.01 100 | tee "$OUT/operator_np$n.txt"
 done
 
 # 2. Preconditioners at three resolutions and two time steps (the step's Newton system and a random load).
@@ -43,4 +44,27 @@ mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/bench/muelu_variants/study.xml" --out
 # 7. The largest resolution that fits here (Δx = 0.005, ~16 GB, ~30 minutes).
 /usr/bin/time -v mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/bench/muelu_variants/largest.xml" --output "$OUT/largest" \
   > "$OUT/largest.txt" 2>&1
+
+# 8. Whole frames at Δx = 0.01 on 2 ranks: the paper's solver against the assembled ones and the
+#    geometric multigrid, each with the Newton strategies (exact, inexact, Hessian once per step,
+#    lagged), to the same Newton tolerance (~45 minutes).
+mpiexec -np 2 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_frames.xml" --output "$OUT/sponge_frames" \
+  | tee "$OUT/sponge_frames.txt"
+
+# 9. Multigrid per Newton system: Δx 0.02 and 0.01 at 100x and 1000x CFL (the shipped study adds
+#    Δx = 0.005 and 10x CFL: hours on this machine).
+mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_multigrid.xml" --output "$OUT/multigrid" \
+  --set "Cell sizes={0.02, 0.01}" --set "Time steps={100, 1000}" | tee "$OUT/multigrid.txt"
+
+# 10. The demo before and after the assembly and multigrid work: BASELINE_BIN names the bin/ of a
+#     build of the commit before them (git worktree add ../baseline d9da441; build it there).
+if [[ -n "${BASELINE_BIN:-}" ]]; then
+  for n in 1 2; do
+    for which in new baseline; do
+      bin="$BIN"; [[ $which == baseline ]] && bin="$BASELINE_BIN"
+      /usr/bin/time -v mpiexec -np $n "$bin/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" \
+        --output "$OUT/demo_${which}_np$n" > "$OUT/demo_${which}_np$n.txt" 2> "$OUT/demo_${which}_np$n.time"
+    done
+  done
+fi
 echo "benchmarks in $OUT"

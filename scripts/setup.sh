@@ -33,5 +33,7 @@ fi
 # Open MPI refuses to run as root (containers, CI) and more ranks than cores unless told.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 
-cmake -S "$VISCOMPM_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# VISCOMPM_CMAKE_ARGS: extra configure options (scripts/test.sh --sanitize sets VISCOMPM_SANITIZE).
+# shellcheck disable=SC2086
+cmake -S "$VISCOMPM_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release ${VISCOMPM_CMAKE_ARGS:-} >/dev/null
 cmake --build "$BUILD_DIR" -j "$JOBS"

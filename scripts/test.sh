@@ -1,8 +1,29 @@
 #!/usr/bin/env bash
-# Builds viscompm (installing what is missing) and runs the whole test suite with ctest,
-# the MPI tests at their registered rank counts included. Extra arguments go to ctest.
+# Builds viscompm (installing what is missing) and runs the whole test suite with ctest, the MPI
+# tests at their registered rank counts included. Extra arguments go to ctest (e.g. -L unit).
+#
+#   scripts/test.sh                     build/ and every test
+#   scripts/test.sh --sanitize [-L ..]  build-sanitize/ with AddressSanitizer and
+#                                       UndefinedBehaviorSanitizer, leaks checked, the known leaks
+#                                       of MPI and Trilinos suppressed (scripts/sanitizers/)
 set -euo pipefail
-source "$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/setup.sh"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+ctest_args=()
+sanitize=0
+for argument in "$@"; do
+  if [ "$argument" = "--sanitize" ]; then sanitize=1; else ctest_args+=("$argument"); fi
+done
+if [ "$sanitize" = 1 ]; then
+  export VISCOMPM_BUILD_DIR="${VISCOMPM_BUILD_DIR:-$here/../build-sanitize}"
+  export VISCOMPM_CMAKE_ARGS="${VISCOMPM_CMAKE_ARGS:-} -DVISCOMPM_SANITIZE=ON"
+  # Every error stops the program (exit 1 from the sanitizers' report); leaks are reported at
+  # exit, except those listed (each explained) in the suppression files.
+  suppressions="$here/sanitizers"
+  export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:verify_asan_link_order=0:suppressions=$suppressions/asan.supp"
+  export LSAN_OPTIONS="suppressions=$suppressions/lsan.supp:print_suppressions=0"
+  export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$suppressions/ubsan.supp"
+fi
+source "$here/setup.sh"
 
 cd "$BUILD_DIR"
-ctest --output-on-failure -j "$JOBS" "$@"
+ctest --output-on-failure -j "$JOBS" ${ctest_args[@]+"${ctest_args[@]}"}

@@ -2,12 +2,14 @@
 
 #include <Teuchos_DefaultComm.hpp>
 #include <Teuchos_TimeMonitor.hpp>
+#include <cstring>
 #include <iostream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/environment.hpp"
 #include "viscompm/scene/command_line.hpp"
 #include "viscompm/simulation/simulation.hpp"
+#include "viscompm/simulation/stop_request.hpp"
 
 namespace viscompm::app {
 
@@ -30,6 +32,7 @@ int run_with_exit_codes(const std::string& program, const parallel::Communicator
 
 int run_simulation_program(int argc, char** argv) {
   linalg::Environment environment(&argc, &argv);
+  simulation::install_stop_handlers();
   const parallel::Communicator comm(MPI_COMM_WORLD);
   const bool root = comm.is_root();
   return run_with_exit_codes("viscompm", comm, [&] {
@@ -39,7 +42,8 @@ int run_simulation_program(int argc, char** argv) {
         "viscompm: implicit Material Point Method for viscoelastic fluids, foams and sponges (Ram 2015),\n"
         "with the Newton systems assembled into Tpetra and solved by Belos CG.\n"
         "Writes DIR/frame_NNNNN.h5, DIR/particles.xdmf and DIR/solver.csv.\n"
-        "Exit codes: 0 success, 2 bad input, 3 the simulation failed.";
+        "Exit codes: 0 success, 2 bad input, 3 the simulation failed, 4 stopped by SIGTERM or SIGINT after\n"
+        "writing a checkpoint (continue with --restart).";
     options.epilogue = "\nScene parameters (sections of SCENE.xml, addressable by --set):\n" +
                        scene::describe_scene_parameters();
     const scene::CommandLine cl = scene::parse_command_line(argc, argv, options);
@@ -48,10 +52,16 @@ int run_simulation_program(int argc, char** argv) {
       return exit_success;
     }
     const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
-    const linalg::SolverConfiguration solver =
-        linalg::SolverConfiguration::read(cl.solver_file.empty() ? scene.solver_file : cl.solver_file);
+    const linalg::SolverConfiguration solver = linalg::SolverConfiguration::read(scene.solver_file);
     simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);
+    if (summary.stop_signal != 0) {
+      if (root)
+        std::cerr << "viscompm: stopped by signal " << summary.stop_signal << " (" << strsignal(summary.stop_signal)
+                  << ") at t = " << simulation.time() << ", step " << simulation.step_count() << "; continue with --restart "
+                  << summary.stop_checkpoint << std::endl;
+      return exit_interrupted;
+    }
     Teuchos::TimeMonitor::summarize(std::cout, false, true, false, Teuchos::Union, "viscompm:");
     if (root)
       std::cout << "done: " << summary.steps << " steps, " << summary.newton_iterations << " Newton iterations, "

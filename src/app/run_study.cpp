@@ -18,8 +18,13 @@ std::string describe_study_parameters() {
   return text;
 }
 
-// The plot scripts next to the sources this program was built from.
-std::string plot_script(const std::string& name) { return std::string(VISCOMPM_SOURCE_DIR) + "/scripts/" + name; }
+// The plot scripts, installed beside the program: BIN/../share/viscompm/scripts (the build tree
+// has the same layout).
+std::string plot_script(const std::string& name) {
+  std::error_code error;
+  const std::filesystem::path program = std::filesystem::canonical("/proc/self/exe", error);
+  return (program.parent_path() / VISCOMPM_DATA_FROM_BIN / "scripts" / name).lexically_normal().string();
+}
 }  // namespace
 
 int run_study_program(int argc, char** argv) {

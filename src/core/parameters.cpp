@@ -10,9 +10,17 @@ namespace viscompm {
 namespace {
 std::string number_text(double x) {
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  if (std::isnan(x)) return "nan";
   std::ostringstream s;
   s << x;
   return s.str();
+}
+
+// Empty if x is a finite number inside the range, else the reason.
+std::string range_problem(const ParameterSpec& spec, double x) {
+  if (!std::isfinite(x)) return "value " + number_text(x) + " is not a finite number";
+  const bool ok = (spec.min_inclusive ? x >= spec.min : x > spec.min) && (spec.max_inclusive ? x <= spec.max : x < spec.max);
+  return ok ? std::string() : "value " + number_text(x) + " is out of range " + spec.range_text();
 }
 }  // namespace
 
@@ -45,10 +53,7 @@ std::string ParameterSpec::range_text() const {
 
 std::string ParameterSpec::check(const ParameterValue& value) const {
   if (type == Type::real || type == Type::integer) {
-    const double x = type == Type::real ? std::get<double>(value) : std::get<int>(value);
-    const bool ok = std::isfinite(x) && (min_inclusive ? x >= min : x > min) &&
-                    (max_inclusive ? x <= max : x < max);
-    if (!ok) return "value " + number_text(x) + " is out of range " + range_text();
+    return range_problem(*this, type == Type::real ? std::get<double>(value) : std::get<int>(value));
   } else if (type == Type::string && !choices.empty()) {
     const auto& s = std::get<std::string>(value);
     for (const auto& c : choices)
@@ -57,11 +62,10 @@ std::string ParameterSpec::check(const ParameterValue& value) const {
   } else if (type == Type::real_list) {
     const auto& list = std::get<RealList>(value);
     for (double x : list)
-      if (!std::isfinite(x) || !(min_inclusive ? x >= min : x > min) || !(max_inclusive ? x <= max : x < max))
-        return "value " + number_text(x) + " is out of range " + range_text();
+      if (const std::string problem = range_problem(*this, x); !problem.empty()) return problem;
   } else if (type == Type::vector3) {
     const auto& v = std::get<Vec3>(value);
-    if (!v.allFinite()) return "value has a non-finite component";
+    if (!v.allFinite()) return "value has a non-finite component (every component must be a finite number)";
   }
   return {};
 }

@@ -117,8 +117,16 @@ void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& fram
       out << "  </Grid>\n";
     }
     out << " </Domain>\n</Xdmf>\n";
+    out.close();
+    std::error_code error;
+    if (!out) {
+      std::filesystem::remove(temporary, error);
+      throw SimulationError("cannot write " + temporary + ": " + write_failure_reason(temporary));
+    }
   }
-  std::filesystem::rename(temporary, path);
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw SimulationError("cannot write " + path.string() + ": " + write_failure_reason(path.string()));
 }
 
 }  // namespace viscompm::io

@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <type_traits>
 
@@ -10,9 +12,14 @@
 namespace viscompm::io {
 
 namespace {
-void check(herr_t status, const std::string& what) {
-  if (status < 0) throw SimulationError("HDF5 error: " + what);
-}
+// The first failure of a collective write, if any. Writes go on after a failure so that every
+// rank makes the same sequence of collective calls; the ranks agree on the outcome at the end.
+struct WriteStatus {
+  std::string failed;  ///< what failed first on this rank, empty if nothing
+  void check(long long status, const std::string& what) {
+    if (status < 0 && failed.empty()) failed = what;
+  }
+};
 
 template <class T>
 hid_t memory_type() {
@@ -62,7 +69,7 @@ void unflatten(const std::vector<double>& flat, std::vector<T>& field) {
 
 // Creates dataset `name` of n_total rows and writes this rank's rows at `offset` (collective).
 template <class D>
-void write_rows(hid_t group, const std::string& name, hid_t type, const std::vector<D>& data,
+void write_rows(WriteStatus& status, hid_t group, const std::string& name, hid_t type, const std::vector<D>& data,
                 const std::vector<hsize_t>& shape, hsize_t n_local, hsize_t offset, hsize_t n_total) {
   std::vector<hsize_t> dims = {n_total}, start = {offset}, count = {n_local};
   for (hsize_t d : shape) {
@@ -73,19 +80,20 @@ void write_rows(hid_t group, const std::string& name, hid_t type, const std::vec
   const int rank = static_cast<int>(dims.size());
   const hid_t file_space = H5Screate_simple(rank, dims.data(), nullptr);
   const hid_t dataset = H5Dcreate2(group, name.c_str(), type, file_space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  status.check(dataset, "create dataset " + name);
   const hid_t memory_space = H5Screate_simple(rank, count.data(), nullptr);
   if (n_local > 0) {
-    check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), name);
+    status.check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), name);
   } else {
     H5Sselect_none(file_space);
     H5Sselect_none(memory_space);
   }
   const hid_t transfer = H5Pcreate(H5P_DATASET_XFER);
   H5Pset_dxpl_mpio(transfer, H5FD_MPIO_COLLECTIVE);
-  check(H5Dwrite(dataset, type, memory_space, file_space, transfer, data.data()), name);
+  status.check(H5Dwrite(dataset, type, memory_space, file_space, transfer, data.data()), "write " + name);
   H5Pclose(transfer);
   H5Sclose(memory_space);
-  H5Dclose(dataset);
+  status.check(H5Dclose(dataset), "close " + name);
   H5Sclose(file_space);
 }
 
@@ -127,22 +135,24 @@ bool read_rows(hid_t group, const std::string& name, hid_t type, std::vector<D>&
   return status >= 0;
 }
 
-void write_string_attribute(hid_t object, const std::string& name, const std::string& value) {
+void write_string_attribute(WriteStatus& status, hid_t object, const std::string& name, const std::string& value) {
   const hid_t type = H5Tcopy(H5T_C_S1);
   H5Tset_size(type, value.size() + 1);
   const hid_t space = H5Screate(H5S_SCALAR);
   const hid_t attribute = H5Acreate2(object, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
-  check(H5Awrite(attribute, type, value.c_str()), name);
+  status.check(attribute, "attribute " + name);
+  status.check(H5Awrite(attribute, type, value.c_str()), "attribute " + name);
   H5Aclose(attribute);
   H5Sclose(space);
   H5Tclose(type);
 }
 
 template <class T>
-void write_scalar_attribute(hid_t object, const std::string& name, hid_t type, T value) {
+void write_scalar_attribute(WriteStatus& status, hid_t object, const std::string& name, hid_t type, T value) {
   const hid_t space = H5Screate(H5S_SCALAR);
   const hid_t attribute = H5Acreate2(object, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
-  check(H5Awrite(attribute, type, &value), name);
+  status.check(attribute, "attribute " + name);
+  status.check(H5Awrite(attribute, type, &value), "attribute " + name);
   H5Aclose(attribute);
   H5Sclose(space);
 }
@@ -183,32 +193,44 @@ std::int64_t write_particle_file(const std::string& path, const FileAttributes& 
   if (comm.rank() == 0) offset = 0;
   MPI_Allreduce(&n_local, &n_total, 1, MPI_LONG_LONG, MPI_SUM, comm.comm());
 
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures become one message, not HDF5's stack
+  WriteStatus status;
   const hid_t access = H5Pcreate(H5P_FILE_ACCESS);
   H5Pset_fapl_mpio(access, comm.comm(), MPI_INFO_NULL);
   const hid_t file = H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access);
   H5Pclose(access);
-  if (file < 0) throw SimulationError("cannot create " + temporary);
-  for (const auto& [name, value] : attributes.reals) write_scalar_attribute(file, name, H5T_NATIVE_DOUBLE, value);
-  for (const auto& [name, value] : attributes.integers) write_scalar_attribute(file, name, H5T_NATIVE_INT64, value);
-  for (const auto& [name, value] : attributes.strings) write_string_attribute(file, name, value);
+  // Creating the file is collective and fails on every rank alike.
+  if (comm.any(file < 0)) throw SimulationError("cannot create " + temporary + ": " + write_failure_reason(temporary));
+  for (const auto& [name, value] : attributes.reals) write_scalar_attribute(status, file, name, H5T_NATIVE_DOUBLE, value);
+  for (const auto& [name, value] : attributes.integers) write_scalar_attribute(status, file, name, H5T_NATIVE_INT64, value);
+  for (const auto& [name, value] : attributes.strings) write_string_attribute(status, file, name, value);
   for (const auto& [name, values] : attributes.real_arrays)
-    write_rows(file, name, H5T_NATIVE_DOUBLE, values, {}, comm.is_root() ? values.size() : 0, 0, values.size());
+    write_rows(status, file, name, H5T_NATIVE_DOUBLE, values, {}, comm.is_root() ? values.size() : 0, 0, values.size());
   const hid_t group = H5Gcreate2(file, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  status.check(group, "create /particles");
   const auto rows = static_cast<hsize_t>(n_local), start = static_cast<hsize_t>(offset),
              total = static_cast<hsize_t>(n_total);
+  // After each dataset the ranks agree whether to go on, so that no rank enters a collective
+  // write the others have abandoned.
+  bool abandoned = comm.any(!status.failed.empty());
   particles.for_each_field([&](const char* name, const auto& field) {
     using T = typename std::decay_t<decltype(field)>::value_type;
-    write_rows(group, name, memory_type<T>(), flatten(field), row_shape<T>(), rows, start, total);
+    if (abandoned) return;
+    write_rows(status, group, name, memory_type<T>(), flatten(field), row_shape<T>(), rows, start, total);
+    abandoned = comm.any(!status.failed.empty());
   });
   for (const auto& d : derived) {
+    if (abandoned) break;
     std::vector<Mat3> values(particles.size());
     for (std::size_t p = 0; p < values.size(); ++p) values[p] = d.value(p);
-    write_rows(group, d.name, H5T_NATIVE_DOUBLE, flatten(values), {3, 3}, rows, start, total);
+    write_rows(status, group, d.name, H5T_NATIVE_DOUBLE, flatten(values), {3, 3}, rows, start, total);
+    abandoned = comm.any(!status.failed.empty());
   }
-  write_string_attribute(group, "material_names", material_names);
-  H5Gclose(group);
+  write_string_attribute(status, group, "material_names", material_names);
+  status.check(H5Gclose(group), "close /particles");
   for (const Table& table : tables) {
     // Collective creation, rows from rank 0.
+    if (abandoned) break;
     const auto slash = table.path.rfind('/');
     hid_t parent = file;
     if (slash != std::string::npos) {
@@ -216,21 +238,50 @@ std::int64_t write_particle_file(const std::string& path, const FileAttributes& 
       parent = H5Lexists(file, group_name.c_str(), H5P_DEFAULT) > 0
                    ? H5Gopen2(file, group_name.c_str(), H5P_DEFAULT)
                    : H5Gcreate2(file, group_name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      status.check(parent, "create /" + group_name);
     }
     const std::string name = slash == std::string::npos ? table.path : table.path.substr(slash + 1);
     const std::size_t size = table.integers.empty() ? table.reals.size() : table.integers.size();
     const hsize_t rows_total = size / table.columns, rows_here = comm.is_root() ? rows_total : 0;
     if (table.integers.empty())
-      write_rows(parent, name, H5T_NATIVE_DOUBLE, table.reals, {table.columns}, rows_here, 0, rows_total);
+      write_rows(status, parent, name, H5T_NATIVE_DOUBLE, table.reals, {table.columns}, rows_here, 0, rows_total);
     else
-      write_rows(parent, name, H5T_NATIVE_INT64, table.integers, {table.columns}, rows_here, 0, rows_total);
-    if (parent != file) H5Gclose(parent);
+      write_rows(status, parent, name, H5T_NATIVE_INT64, table.integers, {table.columns}, rows_here, 0, rows_total);
+    if (parent != file && parent >= 0) H5Gclose(parent);
+    abandoned = comm.any(!status.failed.empty());
   }
-  check(H5Fclose(file), "close " + temporary);
-  comm.barrier();
-  if (comm.is_root()) std::filesystem::rename(temporary, path);
-  comm.barrier();
+  status.check(H5Fclose(file), "close");
+  // Every rank learns whether any failed; the file becomes visible only when complete.
+  std::string failure;
+  if (comm.any(!status.failed.empty())) {
+    failure = status.failed.empty() ? "failed on another rank" : status.failed;
+  } else if (comm.is_root()) {
+    std::error_code error;
+    std::filesystem::rename(temporary, path, error);
+    if (error) failure = "rename to " + path + ": " + error.message();
+  }
+  if (comm.any(!failure.empty())) {
+    if (comm.is_root()) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+    }
+    throw SimulationError("cannot write " + path + " (" + (failure.empty() ? "failed on rank 0" : failure) +
+                          "): " + write_failure_reason(temporary));
+  }
   return n_total;
+}
+
+std::string write_failure_reason(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path directory = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  std::error_code error;
+  if (!fs::exists(directory, error)) return "the directory " + directory.string() + " does not exist (any more)";
+  if (!fs::is_directory(directory, error)) return directory.string() + " is not a directory";
+  if (::access(directory.c_str(), W_OK) != 0) return "the directory " + directory.string() + " is not writable";
+  const fs::space_info space = fs::space(directory, error);
+  if (!error && space.available < (std::uintmax_t(1) << 20))
+    return "the disk is full (" + std::to_string(space.available / 1024) + " KiB free)";
+  return "a write failed (disk full, a file-size limit or an I/O error)";
 }
 
 FileAttributes read_file_attributes(const std::string& path, std::int64_t& particle_count) {

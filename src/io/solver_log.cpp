@@ -3,18 +3,14 @@
 #include <filesystem>
 #include <iomanip>
 
-#include "viscompm/core/error.hpp"
-
 namespace viscompm::io {
 
 SolverLog::SolverLog(const std::string& directory, bool is_root, int ranks, bool append)
-    : is_root_(is_root), ranks_(ranks) {
+    : is_root_(is_root), ranks_(ranks), path_((std::filesystem::path(directory) / "solver.csv").string()) {
   if (!is_root_) return;
-  const auto path = std::filesystem::path(directory) / "solver.csv";
-  const bool write_header = !append || !std::filesystem::exists(path);
-  out_.open(path, append ? std::ios::app : std::ios::trunc);
-  if (!out_) throw SimulationError("cannot write " + path.string());
-  if (write_header) out_ << header << "\n";
+  const bool write_header = !append || !std::filesystem::exists(path_);
+  out_.open(path_, append ? std::ios::app : std::ios::trunc);
+  if (out_ && write_header) out_ << header << "\n" << std::flush;
 }
 
 void SolverLog::record(std::int64_t step, int newton_iteration, const linalg::LinearSolveReport& r) {

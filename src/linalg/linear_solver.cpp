@@ -2,13 +2,13 @@
 
 #include <BelosSolverFactory.hpp>
 #include <BelosTpetraAdapter.hpp>
-#include <Ifpack2_Parameters.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
 
 #include "solver_configuration_impl.hpp"
+#include "solver_validation.hpp"
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/linalg_types.hpp"
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 
 namespace viscompm::linalg {
 
@@ -42,26 +42,11 @@ namespace {
 constexpr const char* krylov_sublist = "Krylov parameters";
 constexpr const char* preconditioner_sublist = "Preconditioner parameters";
 
-// Every key of `given` must be a key of `valid` (Teuchos' own lists of valid parameters).
-void check_known(const Teuchos::ParameterList& given, const Teuchos::ParameterList& valid,
-                 const std::string& file, const std::string& path) {
-  std::vector<std::string> names;
-  for (auto it = valid.begin(); it != valid.end(); ++it) names.push_back(valid.name(it));
-  for (auto it = given.begin(); it != given.end(); ++it) {
-    const std::string& name = given.name(it);
-    if (valid.isParameter(name)) continue;
-    std::string reason = "unknown parameter";
-    const std::string hint = scene::closest_name(name, names);
-    if (!hint.empty()) reason += " (did you mean '" + hint + "'?)";
-    throw InputError(file + ": parameter '" + path + "/" + name + "': " + reason);
-  }
-}
-
 std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& list, const std::string& origin) {
   auto impl = std::make_shared<SolverConfiguration::Impl>();
   impl->origin = origin;
   const ParameterValues values =
-      scene::read_parameters(list, SolverSettings::table().specs(), origin, "", {krylov_sublist, preconditioner_sublist});
+      params::read_parameters(list, SolverSettings::table().specs(), origin, "", {krylov_sublist, preconditioner_sublist});
   impl->settings = SolverSettings::table().parse(values);
   SolverSettings& s = impl->settings;
 
@@ -70,26 +55,22 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   impl->preconditioner_parameters = Teuchos::rcp(new Teuchos::ParameterList(
       list.isSublist(preconditioner_sublist) ? list.sublist(preconditioner_sublist) : Teuchos::ParameterList()));
 
-  // Belos knows its parameters: reject misspellings now rather than ignore them later.
+  // Belos, Ifpack2 and MueLu know their parameters: a misspelled name, a wrong type or a bad value
+  // is bad input now rather than a failure (or a hang) once particles are sampled and solved.
   Belos::SolverFactory<scalar_type, multivector_type, operator_type> factory;
   auto solver = factory.create(s.krylov_solver, Teuchos::null);
-  check_known(*impl->krylov_parameters, *solver->getValidParameters(), origin, krylov_sublist);
+  validate_krylov_parameters(*impl->krylov_parameters, *solver->getValidParameters(), origin, krylov_sublist);
 
   if (s.operator_form == "matrix-free" && (s.preconditioner == "Ifpack2" || s.preconditioner == "MueLu"))
     throw InputError(origin + ": parameter 'Preconditioner': " + s.preconditioner +
                      " needs the assembled matrix (Operator = assembled)");
-  if (s.preconditioner == "Ifpack2") {
-    Teuchos::ParameterList valid;
-    Ifpack2::getValidParameters(valid);
-    // AdditiveSchwarz reads its inner preconditioner under names Ifpack2's list omits.
-    for (const char* name : {"inner preconditioner name", "subdomain solver name", "schwarz: inner preconditioner name",
-                             "schwarz: subdomain solver name"})
-      valid.set(name, std::string());
-    for (const char* name : {"inner preconditioner parameters", "subdomain solver parameters",
-                             "schwarz: inner preconditioner parameters", "schwarz: subdomain solver parameters"})
-      valid.sublist(name);
-    check_known(*impl->preconditioner_parameters, valid, origin, preconditioner_sublist);
-  }
+  if (s.preconditioner == "Ifpack2")
+    validate_ifpack2_parameters(s.ifpack2_type, *impl->preconditioner_parameters, origin, "Ifpack2 type",
+                                preconditioner_sublist);
+  if (s.preconditioner == "MueLu") validate_muelu_parameters(*impl->preconditioner_parameters, origin, preconditioner_sublist);
+  if ((s.preconditioner == "none" || s.preconditioner == "Jacobi") && impl->preconditioner_parameters->numParams() > 0)
+    throw InputError(origin + ": parameter '" + preconditioner_sublist + "': " + s.preconditioner +
+                     " takes no parameters");
   if (s.prolongation != "algebraic" && s.preconditioner != "MueLu")
     throw InputError(origin + ": parameter 'Prolongation': geometric prolongators are for Preconditioner = MueLu");
   if (s.label.empty()) {
@@ -104,7 +85,7 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
 
 SolverConfiguration SolverConfiguration::read(const std::string& file) {
   SolverConfiguration c;
-  c.impl_ = parse(*scene::read_xml_file(file), file);
+  c.impl_ = parse(*params::read_xml_file(file), file);
   return c;
 }
 

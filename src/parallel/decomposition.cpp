@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <string>
+
+#include "viscompm/core/error.hpp"
 
 namespace viscompm::parallel {
 
 BlockDecomposition::BlockDecomposition(const grid::GridGeometry& geometry, int ranks)
-    : ranks_(ranks), nodes_(geometry.nodes()) {
+    : nodes_(geometry.nodes()) {
   // Choose the process grid with the smallest total block surface (fewest shared nodes).
   double best_surface = std::numeric_limits<double>::max();
   for (int px = 1; px <= ranks; ++px) {
@@ -26,7 +29,9 @@ BlockDecomposition::BlockDecomposition(const grid::GridGeometry& geometry, int r
     }
   }
   if (best_surface == std::numeric_limits<double>::max())
-    throw std::invalid_argument("grid too small for the number of ranks");
+    throw InputError("parameter 'Grid/Cell size': a grid of " + std::to_string(nodes_.x()) + "x" +
+                     std::to_string(nodes_.y()) + "x" + std::to_string(nodes_.z()) + " nodes cannot be split among " +
+                     std::to_string(ranks) + " ranks");
   for (int d = 0; d < 3; ++d) {
     const int p = process_grid_[d];
     cuts_[d].resize(p + 1);
@@ -51,21 +56,6 @@ int BlockDecomposition::owner_of_node(const Int3& ijk) const {
 std::string BlockDecomposition::describe() const {
   return "blocks " + std::to_string(process_grid_.x()) + "x" + std::to_string(process_grid_.y()) + "x" +
          std::to_string(process_grid_.z());
-}
-
-void BlockDecomposition::owned_block(int rank, Int3& lower, Int3& upper) const {
-  const int a = rank % process_grid_.x();
-  const int b = (rank / process_grid_.x()) % process_grid_.y();
-  const int c = rank / (process_grid_.x() * process_grid_.y());
-  lower = Int3(cuts_[0][a], cuts_[1][b], cuts_[2][c]);
-  upper = Int3(cuts_[0][a + 1], cuts_[1][b + 1], cuts_[2][c + 1]);
-}
-
-void BlockDecomposition::set_cuts(int d, std::vector<int> cuts) {
-  if (cuts.size() != cuts_[d].size() || cuts.front() != 0 || cuts.back() != nodes_[d] ||
-      !std::is_sorted(cuts.begin(), cuts.end()))
-    throw std::invalid_argument("invalid decomposition cuts");
-  cuts_[d] = std::move(cuts);
 }
 
 }  // namespace viscompm::parallel

@@ -72,12 +72,6 @@ void ParticleSet::permute(const std::vector<std::size_t>& order) {
   });
 }
 
-void ParticleSet::append_from(const ParticleSet& other, std::size_t p) {
-  std::vector<double> buffer;
-  pack_particle(other, p, buffer);
-  unpack_particles(buffer, *this);
-}
-
 std::size_t packed_doubles_per_particle() {
   std::size_t n = 0;
   ParticleSet probe;

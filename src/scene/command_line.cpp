@@ -1,6 +1,7 @@
 #include "viscompm/scene/command_line.hpp"
 
 #include <Teuchos_CommandLineProcessor.hpp>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 
@@ -66,7 +67,8 @@ CommandLine parse_command_line(int argc, const char* const* argv, const ProgramO
   if (cl.input_file.empty()) throw InputError("missing " + options.input_name + " (see --help)");
   if (!output.empty()) cl.overrides.push_back({options.output_parameter, output});
   if (!frames.empty()) cl.overrides.push_back({options.frames_parameter, frames});
-  cl.solver_file = solver;
+  // The scene resolves Solver/File relative to itself; --solver is relative to where we are.
+  if (!solver.empty()) cl.overrides.push_back({"Solver/File", std::filesystem::absolute(solver).string()});
   cl.restart_file = restart;
   return cl;
 }

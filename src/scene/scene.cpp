@@ -2,6 +2,7 @@
 
 #include <Teuchos_ParameterList.hpp>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -9,9 +10,15 @@
 #include "viscompm/core/shape.hpp"
 #include "viscompm/geometry/level_set.hpp"
 #include "viscompm/materials/registry.hpp"
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 
 namespace viscompm::scene {
+
+using params::check_entries;
+using params::parse_value;
+using params::read_parameters;
+using params::read_xml_file;
+using params::set_entry;
 
 const ParameterTable<SimulationSettings>& SimulationSettings::table() {
   static const ParameterTable<SimulationSettings> t = [] {
@@ -22,7 +29,11 @@ const ParameterTable<SimulationSettings>& SimulationSettings::table() {
         .real(&S::cfl, "CFL", 0.5, Range::open_closed(0.0, 10.0), "Δt ≤ CFL·Δx / max particle speed")
         .real(&S::max_time_step, "Max time step", 1e-2, Range::positive(), "upper bound of Δt [s]")
         .real(&S::min_time_step, "Min time step", 1e-7, Range::positive(),
-              "smallest Δt tried when Newton fails before the run stops [s]")
+              "smallest Δt tried when a step fails before the run stops [s]")
+        .real(&S::time_step_growth, "Time step growth", 1.5, Range::open_closed(1.0, 10.0),
+              "after each successful step the Δt cap grows by this factor (up to Max time step)")
+        .real(&S::time_step_reduction, "Time step reduction", 0.5, {0.0, 1.0, false, false},
+              "a step that fails (Newton, or non-finite values) is retried with Δt times this factor")
         .vector3(&S::gravity, "Gravity", Vec3(0.0, -9.81, 0.0), "gravitational acceleration [m/s^2]")
         .string(&S::transfer, "Transfer", "apic", {"apic", "pic_flip"}, "particle-grid transfer (§3.4, §5.6)")
         .real(&S::flip_ratio, "FLIP ratio", 0.95, Range::closed(0.0, 1.0), "α of the PIC/FLIP blend (pic_flip only)")
@@ -103,6 +114,12 @@ Shape make_shape(const ShapeSettings& s, const std::string& file, const std::str
     throw InputError(file + ": parameter '" + path + "/Upper corner': must exceed Lower corner in every component");
   return shape;
 }
+
+// At most 2^53 grid nodes: their ids, and 3 per node for the Newton unknowns, stay exact in the
+// 64-bit integers (and doubles) that hold them.
+constexpr double max_grid_nodes = 9007199254740992.0;
+// Cell indices per dimension are ints.
+constexpr double max_cells_per_dimension = 1073741824.0;
 
 constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver", "Output", "Materials", "Bodies", "Colliders", "Emitters", "Regions"};
 
@@ -316,6 +333,9 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
                  "where frames, particles.xdmf and solver.csv go (--output overrides it)")
         .integer(&OutputSettings::checkpoint_every, "Checkpoint every", 0, Range::at_least(0),
                  "write DIR/checkpoint_NNNNN.h5 every this many frames (0: never); --restart continues from one")
+        .real(&OutputSettings::checkpoint_wall_seconds, "Checkpoint wall seconds", 0.0, Range::non_negative(),
+              "also write DIR/checkpoint_step_SSSSSSSS.h5 after the step in which this many wall-clock seconds have "
+              "passed since the run started or last wrote one (the newer replaces the older); 0: never")
         .real_list(&OutputSettings::matrix_market_steps, "Matrix Market steps", {}, Range::at_least(1),
                    "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx")
         .real(&OutputSettings::surface_voxel_size, "Surface voxel size", 0.0, Range::non_negative(),
@@ -409,13 +429,16 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   scene.solver_file = solver_path.is_absolute()
                           ? solver_path.string()
                           : (std::filesystem::path(file).parent_path() / solver_path).lexically_normal().string();
+  if (!std::filesystem::is_regular_file(scene.solver_file))
+    throw InputError(file + ": parameter 'Solver/File': cannot open '" + scene.solver_file + "'");
 
   for_each_item(*root, "Materials", file, [&](const std::string& name, const Teuchos::ParameterList& list,
                                               const std::string& path) {
     if (!list.isParameter("Model"))
       throw InputError(file + ": parameter '" + path + "/Model': missing (one of the registered models)");
-    const ParameterValues model_value = read_parameters(
-        Teuchos::ParameterList().set("Model", list.get<std::string>("Model")), {model_spec()}, file, path);
+    Teuchos::ParameterList model_only;  // the model first: it decides the other parameters
+    model_only.setEntry("Model", list.getEntry("Model"));
+    const ParameterValues model_value = read_parameters(model_only, {model_spec()}, file, path);
     const auto* entry = materials::find_model(model_value.string("Model"));
     std::vector<ParameterSpec> specs = {model_spec()};
     specs.insert(specs.end(), entry->parameters.begin(), entry->parameters.end());
@@ -459,6 +482,20 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
     throw InputError(file + ": parameter 'Grid/Cell size': the domain must be several cells wide in every direction");
   if (scene.simulation.min_time_step > scene.simulation.max_time_step)
     throw InputError(file + ": parameter 'Simulation/Min time step': exceeds Max time step");
+  // Node ids are 64-bit integers and the Newton unknowns 3 per node: bound the grid before any
+  // arithmetic in integers (doubles here, so that nothing overflows).
+  double nodes = 1.0, widest = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    nodes *= std::ceil(extent[d] / scene.grid.cell_size) + 1.0;
+    widest = std::max(widest, std::ceil(extent[d] / scene.grid.cell_size));
+  }
+  if (nodes > max_grid_nodes || widest > max_cells_per_dimension) {
+    std::ostringstream reason;
+    reason << file << ": parameter 'Grid/Cell size': " << scene.grid.cell_size << " m makes " << nodes
+           << " grid nodes (" << widest << " cells across), more than viscompm can number (" << max_grid_nodes
+           << " nodes, " << max_cells_per_dimension << " cells across)";
+    throw InputError(reason.str());
+  }
   return scene;
 }
 

@@ -1,27 +1,102 @@
 #include "viscompm/simulation/simulation.hpp"
 
-#include <Teuchos_TimeMonitor.hpp>
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <numeric>
+#include <fstream>
 #include <iomanip>
-#include <sstream>
+#include <numeric>
 #include <ostream>
+#include <sstream>
+#include <type_traits>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/io/checkpoint.hpp"
 #include "viscompm/geometry/level_set.hpp"
 #include "viscompm/io/collider_output.hpp"
 #include "viscompm/io/particle_file.hpp"
+#include "viscompm/linalg/rcb_partition.hpp"
 #include "viscompm/materials/registry.hpp"
 #include "viscompm/parallel/migration.hpp"
-#include "viscompm/parallel/rcb_partition.hpp"
 #include "viscompm/particles/sampling.hpp"
 #include "viscompm/simulation/scene_objects.hpp"
+#include "viscompm/simulation/stop_request.hpp"
 
 namespace viscompm::simulation {
 
+namespace {
+// Step control: choices §5.5.1 leaves open (doc/numerics.md, "Time step"). The growth and
+// reduction factors of Δt are scene parameters (Simulation/Time step growth, ... reduction).
+/// advance_to has reached t_end when within this relative distance of it (round-off of Σ Δt).
+constexpr double end_tolerance = 1e-14;
+/// A step this close (relative) to the time left before the frame is stretched to land on it.
+constexpr double landing_tolerance = 1e-9;
+/// No sliver step before a frame: a step longer than this fraction of the time left is
+/// shortened to it, so that the last two steps share the remainder.
+constexpr double sliver_fraction = 0.5;
+/// Re-partition again only when the imbalance exceeds what the last re-partition reached by
+/// this factor (cells are indivisible: a re-partition cannot always reach the threshold).
+constexpr double rebalance_slack = 1.05;
+/// Retries shown in the log; later ones are only counted.
+constexpr int retries_logged = 10;
+/// Memory per particle: the default scene's peak memory grows by 3.2 KiB per particle with the
+/// assembled Hessian and Jacobi (doc/contracts.md; MueLu needs more).
+constexpr double bytes_per_particle = 4096.0;
+
+// The memory this rank may use: the machine's, shared among its ranks, or the control group's
+// limit (batch systems) if lower.
+double memory_of_this_rank(const parallel::Communicator& comm) {
+  double bytes = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  for (const char* limit_file : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(limit_file);
+    double limit = 0.0;
+    if (in >> limit && limit > 0.0) bytes = std::min(bytes, limit);
+  }
+  MPI_Comm node;
+  MPI_Comm_split_type(comm.comm(), MPI_COMM_TYPE_SHARED, comm.rank(), MPI_INFO_NULL, &node);
+  int ranks_here = 1;
+  MPI_Comm_size(node, &ranks_here);
+  MPI_Comm_free(&node);
+  return bytes / ranks_here;
+}
+}  // namespace
+
+void check_memory(const scene::SceneConfig& scene, const parallel::Communicator& comm) {
+  // Particles: the lattice sites of each body's bounding box inside the grid (what sampling
+  // visits), times the shape's share of its box. In doubles: nothing overflows.
+  const Vec3 lower = scene.grid.lower_corner, upper = scene.grid.upper_corner;
+  double particles = 0.0;
+  for (const auto& body : scene.bodies) {
+    const Shape shape = scene::shape_of(body);
+    Vec3 lo, hi;
+    shape.bounding_box(lo, hi);
+    const double h = scene.grid.cell_size / body.particles_per_cell;
+    double sites = 1.0;
+    for (int d = 0; d < 3; ++d) sites *= std::max(0.0, std::min(hi[d], upper[d]) - std::max(lo[d], lower[d])) / h;
+    const double share = shape.kind == Shape::Kind::sphere ? M_PI / 6.0 : shape.kind == Shape::Kind::cylinder ? M_PI / 4.0 : 1.0;
+    particles += sites * share;
+  }
+  const double needed = particles * bytes_per_particle;
+  const double available = comm.sum(memory_of_this_rank(comm));
+  if (needed <= available) return;
+  std::ostringstream reason;
+  reason << std::setprecision(3) << scene.file << ": parameter 'Grid/Cell size': " << scene.grid.cell_size
+         << " m gives about " << particles << " particles, an estimated " << needed / 1073741824.0
+         << " GiB (" << bytes_per_particle / 1024.0 << " KiB per particle), more than the " << available / 1073741824.0
+         << " GiB of memory of " << comm.size() << " rank(s)";
+  throw InputError(reason.str());
+}
+
+materials::MaterialList make_materials(const scene::SceneConfig& scene) {
+  materials::MaterialList list;
+  for (const auto& m : scene.materials) list.push_back(materials::find_model(m.model)->create(m.name, m.values));
+  return list;
+}
+
+namespace {
+// The grid a scene asks for: cells of the given size covering [lower, upper] (rounded up).
 grid::GridGeometry make_grid(const scene::GridSettings& g) {
   grid::GridGeometry geometry;
   geometry.origin = g.lower_corner;
@@ -31,12 +106,7 @@ grid::GridGeometry make_grid(const scene::GridSettings& g) {
   return geometry;
 }
 
-materials::MaterialList make_materials(const scene::SceneConfig& scene) {
-  materials::MaterialList list;
-  for (const auto& m : scene.materials) list.push_back(materials::find_model(m.model)->create(m.name, m.values));
-  return list;
-}
-
+// Colliders and domain walls.
 boundary::Boundary make_boundary(const scene::SceneConfig& scene) {
   std::vector<boundary::Collider> colliders = make_colliders(scene);
   boundary::DomainWalls walls;
@@ -45,6 +115,7 @@ boundary::Boundary make_boundary(const scene::SceneConfig& scene) {
   return boundary::Boundary(std::move(colliders), walls, make_inflows(scene));
 }
 
+// The particles of all bodies that this rank owns (ids independent of the rank count).
 particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
                                         grid::KernelOrder order, const parallel::Decomposition& decomposition,
                                         const materials::MaterialList& materials, int rank) {
@@ -68,6 +139,7 @@ particles::ParticleSet sample_particles(const scene::SceneConfig& scene, const g
   }
   return set;
 }
+}  // namespace
 
 namespace {
 // The emitters' layer counts a checkpoint carries (a restart in the middle of emission).
@@ -82,16 +154,24 @@ void restore_emitters(std::vector<particles::Emitter>& emitters, const std::vect
 
 Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
                        const parallel::Communicator& comm, const std::string& restart_file)
+    : Simulation(scene, make_materials(scene), solver, comm, restart_file) {}
+
+Simulation::Simulation(const scene::SceneConfig& scene, materials::MaterialList materials,
+                       const linalg::SolverConfiguration& solver, const parallel::Communicator& comm,
+                       const std::string& restart_file)
     : scene_(scene),
       comm_(comm),
       geometry_(make_grid(scene.grid)),
       order_(grid::kernel_order_from_name(scene.simulation.kernel)),
       decomposition_(std::make_unique<parallel::BlockDecomposition>(geometry_, comm.size())),
-      materials_(make_materials(scene)),
+      materials_(std::move(materials)),
       boundary_(make_boundary(scene)),
       time_step_cap_(scene.simulation.max_time_step) {
   std::vector<double> emitter_layers;  // from the checkpoint
+  if (materials_.size() != scene.materials.size())
+    throw std::invalid_argument("Simulation: one material per scene material expected");
   if (restart_file.empty()) {
+    check_memory(scene, comm_);
     particles_ = sample_particles(scene, geometry_, order_, *decomposition_, materials_, comm.rank());
   } else {
     io::RunState state;
@@ -105,7 +185,14 @@ Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConf
     frame_ = state.frame;
     time_step_cap_ = state.time_step_cap;
     emitter_layers = state.emitter_layers;
+    balanced_imbalance_ = state.balanced_imbalance;
     restarted_ = true;
+    // A checkpoint of another scene or grid: its particles lie outside this grid.
+    const Vec3 lo = geometry_.origin, hi = geometry_.origin + geometry_.dx * geometry_.cells.cast<double>();
+    bool outside = false;
+    for (const Vec3& x : particles_.position) outside |= (x.array() < lo.array()).any() || (x.array() > hi.array()).any();
+    if (comm_.any(outside))
+      throw InputError(restart_file + ": particles lie outside the scene's grid (a checkpoint of another scene?)");
     // The same rank count continues with the same ownership (bit-for-bit restarts).
     if (state.decomposition_boxes.size() == 6u * static_cast<std::size_t>(comm_.size())) {
       std::vector<parallel::BoxDecomposition::Box> boxes(comm_.size());
@@ -152,8 +239,8 @@ void Simulation::rebalance_if_needed(RunSummary& summary, std::ostream* log) {
   const double before = parallel::imbalance(comm_, particles_.size());
   // Re-partition when the threshold is crossed, but not again while the imbalance stays at what
   // the last re-partition could reach (cells are indivisible).
-  if (before <= std::max(threshold, 1.05 * balanced_imbalance_)) return;
-  auto candidate = parallel::make_rcb_decomposition(comm_, geometry_, particles_);
+  if (before <= std::max(threshold, rebalance_slack * balanced_imbalance_)) return;
+  auto candidate = linalg::make_rcb_decomposition(comm_, geometry_, particles_);
   // Keep the new partition only if it balances better (cells are indivisible: on coarse grids
   // the bisection's cut may land where it cannot help).
   std::vector<double> counts(comm_.size(), 0.0);
@@ -176,60 +263,116 @@ void Simulation::rebalance_if_needed(RunSummary& summary, std::ostream* log) {
          << before << " -> " << after << "\n";
 }
 
-void Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log) {
-  const double min_dt = scene_.simulation.min_time_step;
-  while (time_ < t_end * (1.0 - 1e-14)) {
+bool Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log) {
+  while (time_ < t_end * (1.0 - end_tolerance)) {
     rebalance_if_needed(summary, log);
     emit_particles();
     double dt = suggested_time_step();
     const double remaining = t_end - time_;
-    if (dt >= remaining * (1.0 - 1e-9)) dt = remaining;
-    else if (dt > 0.5 * remaining) dt = 0.5 * remaining;  // no sliver step before the frame
-    std::string dump_prefix;
-    for (double s : scene_.output.matrix_market_steps)
-      if (static_cast<std::int64_t>(s) == step_ + 1)
-        dump_prefix = scene_.output.directory + "/newton_step_" + std::to_string(step_ + 1);
-    for (;;) {
-      const StepReport report = integrator_->step(particles_, time_, dt, dump_prefix);
-      const auto& newton = report.newton;
-      for (std::size_t k = 0; k < newton.linear_solves.size(); ++k) {
-        const auto& solve = newton.linear_solves[k];
-        if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), solve);
-        summary.linear_iterations += solve.iterations;
-        summary.operator_seconds += solve.operator_seconds;
-        summary.preconditioner_seconds += solve.setup_seconds;
-        summary.cg_seconds += solve.solve_seconds;
-      }
-      summary.newton_iterations += newton.iterations;
-      summary.assemblies += newton.assemblies;
-      summary.preconditioner_setups += newton.preconditioner_setups;
-      summary.line_search_seconds += newton.line_search_seconds;
-      summary.graph_builds += report.partition_rebuilt;
-      if (newton.converged) {
-        summary.ghost_particle_steps += comm_.sum(static_cast<std::int64_t>(report.ghost_particles));
-        summary.particles_deleted += comm_.sum(static_cast<std::int64_t>(report.particles_deleted));
-        summary.particles_migrated += comm_.sum(static_cast<std::int64_t>(report.particles_sent));
-        summary.shared_node_steps += comm_.sum(static_cast<std::int64_t>(report.shared_nodes));
-        summary.owned_node_steps += comm_.sum(static_cast<std::int64_t>(report.owned_nodes));
-        break;
-      }
-      ++summary.retries;
-      if (dt * 0.5 < min_dt)
-        throw SimulationError("Newton failed at t = " + std::to_string(time_) + " with the smallest Δt (" +
-                              newton.failure + ")");
-      if (log && comm_.is_root() && ++retries_reported_ <= 10)
-        *log << "  step " << step_ + 1 << ": Newton failed (" << newton.failure << ") at Δt = " << dt
-             << ", retrying with Δt/2 [" << newton.history() << "]"
-             << (retries_reported_ == 10 ? " (further retries are counted, not shown)" : "") << "\n";
-      dt *= 0.5;
-      time_step_cap_ = dt;
-    }
-    time_ += dt;
-    ++step_;
-    ++summary.steps;
-    time_step_cap_ = std::min(1.5 * time_step_cap_, scene_.simulation.max_time_step);
+    if (dt >= remaining * (1.0 - landing_tolerance)) dt = remaining;
+    else if (dt > sliver_fraction * remaining) dt = sliver_fraction * remaining;
+    take_step(dt, summary, log);
+    if (in_run_ && stop_requested(summary, log)) return false;
   }
   time_ = t_end;
+  return true;
+}
+
+void Simulation::take_step(double dt, RunSummary& summary, std::ostream* log) {
+  const double min_dt = scene_.simulation.min_time_step;
+  std::string dump_prefix;
+  for (double s : scene_.output.matrix_market_steps)
+    if (static_cast<std::int64_t>(s) == step_ + 1)
+      dump_prefix = scene_.output.directory + "/newton_step_" + std::to_string(step_ + 1);
+  for (;;) {
+    before_step_ = particles_;  // a step that goes non-finite is retried from here
+    const StepReport report = integrator_->step(particles_, time_, dt, dump_prefix);
+    const auto& newton = report.newton;
+    for (std::size_t k = 0; k < newton.linear_solves.size(); ++k) {
+      const auto& solve = newton.linear_solves[k];
+      if (solver_log_) solver_log_->record(step_ + 1, static_cast<int>(k + 1), solve);
+      summary.linear_iterations += solve.iterations;
+      summary.operator_seconds += solve.operator_seconds;
+      summary.preconditioner_seconds += solve.setup_seconds;
+      summary.cg_seconds += solve.solve_seconds;
+    }
+    summary.newton_iterations += newton.iterations;
+    summary.assemblies += newton.assemblies;
+    summary.preconditioner_setups += newton.preconditioner_setups;
+    summary.line_search_seconds += newton.line_search_seconds;
+    summary.graph_builds += report.partition_rebuilt;
+    std::string failure;
+    if (!newton.converged) {
+      failure = "Newton failed (" + newton.failure + ")";
+    } else if (!state_is_finite()) {
+      failure = "the step produced non-finite particle values";
+      particles_ = before_step_;
+    }
+    if (failure.empty()) {
+      summary.ghost_particle_steps += comm_.sum(static_cast<std::int64_t>(report.ghost_particles));
+      summary.particles_deleted += comm_.sum(static_cast<std::int64_t>(report.particles_deleted));
+      summary.particles_migrated += comm_.sum(static_cast<std::int64_t>(report.particles_sent));
+      summary.shared_node_steps += comm_.sum(static_cast<std::int64_t>(report.shared_nodes));
+      summary.owned_node_steps += comm_.sum(static_cast<std::int64_t>(report.owned_nodes));
+      break;
+    }
+    ++summary.retries;
+    const double reduction = scene_.simulation.time_step_reduction;
+    if (dt * reduction < min_dt)
+      throw SimulationError("at t = " + std::to_string(time_) + " with the smallest Δt: " + failure +
+                            "; the last frame written is frame " + std::to_string(frame_));
+    if (log && comm_.is_root() && ++retries_reported_ <= retries_logged)
+      *log << "  step " << step_ + 1 << ": " << failure << " at Δt = " << dt << ", retrying with Δt × " << reduction
+           << (newton.converged ? std::string() : " [" + newton.history() + "]")
+           << (retries_reported_ == retries_logged ? " (further retries are counted, not shown)" : "") << "\n";
+    dt *= reduction;
+    time_step_cap_ = dt;
+  }
+  time_ += dt;
+  ++step_;
+  ++summary.steps;
+  time_step_cap_ = std::min(scene_.simulation.time_step_growth * time_step_cap_, scene_.simulation.max_time_step);
+}
+
+bool Simulation::state_is_finite() const {
+  bool finite = true;
+  particles_.for_each_field([&](const char*, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    if constexpr (std::is_same_v<T, Vec3> || std::is_same_v<T, Mat3>) {
+      for (const auto& value : field) finite &= value.allFinite();
+    } else if constexpr (std::is_same_v<T, double>) {
+      for (double value : field) finite &= std::isfinite(value);
+    }
+  });
+  return !comm_.any(!finite);
+}
+
+bool Simulation::stop_requested(RunSummary& summary, std::ostream* log) {
+  // One agreement per step: a signal may reach only some ranks, the clocks differ, and only
+  // rank 0 writes solver.csv.
+  const double wall = scene_.output.checkpoint_wall_seconds;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_time_).count();
+  double flags[3] = {static_cast<double>(stop_signal()), wall > 0.0 && elapsed >= wall ? 1.0 : 0.0,
+                     solver_log_ && !solver_log_->good() ? 1.0 : 0.0};
+  MPI_Allreduce(MPI_IN_PLACE, flags, 3, MPI_DOUBLE, MPI_MAX, comm_.comm());
+  if (flags[2] > 0.0)
+    throw SimulationError("cannot write " + solver_log_->path() + ": " + io::write_failure_reason(solver_log_->path()));
+  if (flags[0] == 0.0 && flags[1] == 0.0) return false;
+  // A checkpoint between frames, replacing the one this run wrote before.
+  const std::string previous = wall_checkpoint_;
+  wall_checkpoint_ = write_checkpoint_file(io::step_checkpoint_file_name(step_));
+  last_checkpoint_time_ = std::chrono::steady_clock::now();
+  if (comm_.is_root() && !previous.empty() && previous != wall_checkpoint_) {
+    std::error_code ignored;
+    std::filesystem::remove(previous, ignored);
+  }
+  if (flags[0] == 0.0) {
+    if (log && comm_.is_root()) *log << "  step " << step_ << ": checkpoint " << wall_checkpoint_ << "\n";
+    return false;
+  }
+  summary.stop_signal = static_cast<int>(flags[0]);
+  summary.stop_checkpoint = wall_checkpoint_;
+  return true;
 }
 
 namespace {
@@ -241,15 +384,38 @@ std::string clock_text(double seconds) {
 }
 }  // namespace
 
-std::string Simulation::write_checkpoint() {
+std::string Simulation::write_checkpoint() { return write_checkpoint_file(io::checkpoint_file_name(frame_)); }
+
+std::string Simulation::write_checkpoint_file(const std::string& name) {
   integrator_->reset_reuse();  // continue as a run restarted from this checkpoint starts
-  io::RunState state{time_, step_, frame_, time_step_cap_, scene_.name, {}};
+  io::RunState state{time_, step_, frame_, time_step_cap_, scene_.name, {}, {}, balanced_imbalance_};
   if (const auto* boxes = dynamic_cast<const parallel::BoxDecomposition*>(decomposition_.get()))
     for (const auto& b : boxes->boxes())
       state.decomposition_boxes.insert(state.decomposition_boxes.end(),
                                        {b.lower.x(), b.lower.y(), b.lower.z(), b.upper.x(), b.upper.y(), b.upper.z()});
   for (const auto& e : emitters_) state.emitter_layers.push_back(static_cast<double>(e.layers_emitted()));
-  return io::write_checkpoint(scene_.output.directory, state, particles_, materials_, comm_);
+  const std::string path = (std::filesystem::path(scene_.output.directory) / name).string();
+  io::write_checkpoint(path, state, particles_, materials_, comm_);
+  return path;
+}
+
+void Simulation::write_frame(int frame) {
+  frame_ = frame;
+  frames_.push_back(
+      io::write_frame(scene_.output.directory, {frame, time_, step_, 0}, particles_, materials_, comm_, frame_extras()));
+  // Rank 0 writes the index; every rank learns whether it could.
+  std::string failure;
+  if (comm_.is_root()) {
+    try {
+      io::write_xdmf(scene_.output.directory, frames_);
+    } catch (const SimulationError& e) {
+      failure = e.what();
+    }
+  }
+  if (comm_.any(!failure.empty())) throw SimulationError(failure.empty() ? "rank 0 could not write particles.xdmf" : failure);
+  if (scene_.output.surface_voxel_size > 0.0) write_surface(frame);
+  const int every = scene_.output.checkpoint_every;
+  if (every > 0 && frame % every == 0) write_checkpoint();
 }
 
 namespace {
@@ -270,29 +436,26 @@ std::vector<io::FrameInfo> existing_frames(const std::string& directory, int las
 
 RunSummary Simulation::run(std::ostream& log) {
   const std::string& directory = scene_.output.directory;
-  if (comm_.is_root()) {
-    std::error_code error;
-    std::filesystem::create_directories(directory, error);
-    if (error || !std::filesystem::is_directory(directory))
-      throw InputError(scene_.file + ": parameter 'Output/Directory': cannot create '" + directory + "'");
-  }
-  comm_.barrier();
+  std::error_code error;
+  if (comm_.is_root()) std::filesystem::create_directories(directory, error);
+  if (comm_.any(comm_.is_root() && (error || !std::filesystem::is_directory(directory))))
+    throw InputError(scene_.file + ": parameter 'Output/Directory': cannot create '" + directory + "'");
   solver_log_ = std::make_unique<io::SolverLog>(directory, comm_.is_root(), comm_.size(), restarted_);
+  if (comm_.any(!solver_log_->good()))
+    throw SimulationError("cannot write " + solver_log_->path() + ": " + io::write_failure_reason(solver_log_->path()));
 
   RunSummary summary;
   const auto start = std::chrono::steady_clock::now();
-  const int checkpoint_every = scene_.output.checkpoint_every;
-  auto write = [&](int frame) {
-    frame_ = frame;
-    frames_.push_back(io::write_frame(directory, {frame, time_, step_, 0}, particles_, materials_, comm_, frame_extras()));
-    if (comm_.is_root()) io::write_xdmf(directory, frames_);
-    if (scene_.output.surface_voxel_size > 0.0) write_surface(frame);
-    if (checkpoint_every > 0 && frame % checkpoint_every == 0) write_checkpoint();
-  };
+  last_checkpoint_time_ = start;
+  in_run_ = true;
+  struct Leave {  // advance_to outside run() ignores stop requests again, however run() ends
+    bool& flag;
+    ~Leave() { flag = false; }
+  } leave{in_run_};
   if (restarted_) {
     if (comm_.is_root()) frames_ = existing_frames(directory, frame_);  // for the XDMF index
   } else {
-    write(0);
+    write_frame(0);
   }
   const int frames = scene_.simulation.frames;
   const double frame_duration = 1.0 / scene_.simulation.frame_rate;
@@ -300,7 +463,9 @@ RunSummary Simulation::run(std::ostream& log) {
   if (comm_.is_root())
     log << scene_.name << ": " << particle_count << " particles, grid " << geometry_.cells.transpose() << " cells of "
         << geometry_.dx << " m, " << comm_.size() << " rank(s), " << frames << " frames"
-        << (restarted_ ? ", restarted at frame " + std::to_string(frame_) : std::string()) << "\n";
+        << (restarted_ ? ", restarted at t = " + std::to_string(time_) + " (frame " + std::to_string(frame_) + ")"
+                       : std::string())
+        << "\n";
   for (const auto& e : emitters_)
     if (comm_.is_root())
       log << "  emitter " << e.spec().name << ": " << e.layer_size() << " particles per layer, "
@@ -308,8 +473,8 @@ RunSummary Simulation::run(std::ostream& log) {
           << e.particle_mass() * e.layer_size() / e.layer_interval() << " kg/s\n";
   const int first = frame_ + 1;
   for (int frame = first; frame <= frames; ++frame) {
-    advance_to(frame * frame_duration, summary, &log);
-    write(frame);
+    if (!advance_to(frame * frame_duration, summary, &log)) break;
+    write_frame(frame);
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const int done = frame - first + 1;
     if (comm_.is_root())

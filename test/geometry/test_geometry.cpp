@@ -161,6 +161,7 @@ TEST(SceneMeshes, BadMeshesAreOneLineErrorsNamingSceneParameterAndFile) {
     std::ofstream(scene_file)
         << "<ParameterList name=\"s\">"
            "<ParameterList name=\"Grid\"><Parameter name=\"Cell size\" type=\"double\" value=\"0.05\"/></ParameterList>"
+           "<ParameterList name=\"Solver\"><Parameter name=\"File\" type=\"string\" value=\"" VISCOMPM_SOURCE_DIR "/inputs/solvers/jacobi_cg.xml\"/></ParameterList>"
            "<ParameterList name=\"Materials\"><ParameterList name=\"m\"><Parameter name=\"Model\" type=\"string\" value=\"oldroyd_b\"/></ParameterList></ParameterList>"
            "<ParameterList name=\"Bodies\"><ParameterList name=\"b\"><Parameter name=\"Material\" type=\"string\" value=\"m\"/>"
         << (section == "Bodies" ? "<Parameter name=\"Shape\" type=\"string\" value=\"mesh\"/><Parameter name=\"File\" type=\"string\" value=\"" + mesh_file + "\"/>" : "")

@@ -1,4 +1,4 @@
-// Viscosity convention (DESIGN.md §3). A shear wave v_x = V cos(k (y − y0)), k = π/H, in a free
+// Viscosity convention (doc/numerics.md). A shear wave v_x = V cos(k (y − y0)), k = π/H, in a free
 // slab of purely viscous material (its faces y0 and y0 + H are traction free for this mode)
 // decays as e^{−ν k² t}, ν = η/ρ. With the physical convention the rate depends on Δt only
 // through the first-order time error of the implicit step (backward Euler's discrete rate is

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The viscompm program end to end, as users and scripts see it (DESIGN.md section 4):
+"""The viscompm program end to end, as users and scripts see it (doc/contracts.md):
 --help, exit codes with one-line messages, and the output read back with h5py: the HDF5 frame
 schema, the XDMF index ParaView opens, and solver.csv."""
 import argparse
@@ -9,6 +9,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import time
 import xml.etree.ElementTree as ET
 
 import h5py
@@ -64,6 +65,15 @@ check(len(lines) == 1 and scene in lines[0] and "'Materials/sponge/Weissenberg n
       f"one line naming file and parameter: {lines}")
 result = run(scene, "--frames", "1", "--solver", os.path.join(args.inputs, "scenes", "shooting_sponge.xml"))
 check(result.returncode == 2, f"a scene given as solver file exits 2, got {result.returncode}")
+# A scene whose particles cannot fit in memory: exit 2 before sampling, naming the parameter and
+# the estimate (the timeout guards against a run that starts sampling 10^11 particles).
+started = time.time()
+result = run(scene, "--set", "Grid/Cell size=1e-4", "--output", os.path.join(args.workdir, "huge"))
+lines = stderr_lines(result)
+check(result.returncode == 2, f"a grid too fine for memory exits 2, got {result.returncode}")
+check(len(lines) == 1 and "'Grid/Cell size'" in lines[0] and "GiB" in lines[0],
+      f"one line naming Grid/Cell size and the memory estimate: {lines}")
+print(f"memory estimate answered in {time.time() - started:.2f} s: {lines}")
 
 # A small run of the default scene.
 out = os.path.join(args.workdir, "run")

@@ -1,7 +1,8 @@
 // One rank and N ranks agree: the same assembled Newton matrix (global ids, values to rounding)
 // and the same particles — every stored field — after full steps (to solver tolerance), for the
 // sponge scene and for a scene with every constitutive model. The reference runs on a
-// communicator holding rank 0 alone, inside the same test.
+// communicator holding rank 0 alone, inside the same test; registered on more than one rank only
+// (on one rank it would compare a run with itself).
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -18,18 +19,14 @@ namespace {
 // Every stored field of a particle, packed (particles::pack_particle), by id.
 using ParticleStates = std::map<ParticleId, std::vector<double>>;
 
-// All particles of the communicator, by id, on every rank.
-ParticleStates gather_particles(const particles::ParticleSet& ps, MPI_Comm comm) {
-  std::vector<double> local;
-  for (std::size_t p = 0; p < ps.size(); ++p) particles::pack_particle(ps, p, local);
-  const std::vector<double> all = parallel::Communicator(comm).all_gather(local);
+// All particles of the communicator, by id, on every rank, each packed (every stored field).
+ParticleStates gather_packed(const particles::ParticleSet& ps, MPI_Comm comm) {
+  const particles::ParticleSet all = testkit::gather_particle_set(ps, comm);
   ParticleStates out;
-  particles::ParticleSet unpacked;
-  particles::unpack_particles(all, unpacked);
-  const std::size_t stride = particles::packed_doubles_per_particle();
-  for (std::size_t p = 0; p < unpacked.size(); ++p) {
-    std::vector<double> state(all.begin() + p * stride, all.begin() + (p + 1) * stride);
-    EXPECT_TRUE(out.emplace(unpacked.id[p], std::move(state)).second) << "duplicate id " << unpacked.id[p];
+  for (std::size_t p = 0; p < all.size(); ++p) {
+    std::vector<double> state;
+    particles::pack_particle(all, p, state);
+    EXPECT_TRUE(out.emplace(all.id[p], std::move(state)).second) << "duplicate id " << all.id[p];
   }
   return out;
 }
@@ -110,14 +107,14 @@ TEST_P(ParallelAgreement, FullStepsAreTheSameOnOneRankAndOnAll) {
   simulation::Simulation sim(scene_named(GetParam()), testkit::jacobi_cg(1e-12), world);
   simulation::RunSummary summary;
   sim.advance_to(t_end, summary);
-  const auto all = gather_particles(sim.particles(), world.comm());
+  const auto all = gather_packed(sim.particles(), world.comm());
   ParticleStates reference;
   if (MPI_Comm solo = testkit::solo_communicator(); solo != MPI_COMM_NULL) {
     simulation::Simulation solo_sim(scene_named(GetParam()), testkit::jacobi_cg(1e-12), parallel::Communicator(solo));
     simulation::RunSummary solo_summary;
     solo_sim.advance_to(t_end, solo_summary);
     EXPECT_EQ(solo_summary.steps, summary.steps);
-    reference = gather_particles(solo_sim.particles(), solo);
+    reference = gather_packed(solo_sim.particles(), solo);
     MPI_Comm_free(&solo);
   }
   if (!world.is_root()) return;

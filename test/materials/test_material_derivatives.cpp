@@ -5,6 +5,7 @@
 
 #include <set>
 
+#include "model_variants.hpp"
 #include "test_helpers.hpp"
 #include "viscompm/materials/registry.hpp"
 
@@ -12,55 +13,12 @@ using namespace viscompm;
 using namespace viscompm::materials;
 
 namespace {
-struct Variant {
-  std::string label;
-  std::string model;
-  std::vector<std::pair<std::string, ParameterValue>> values;
-};
-
-std::vector<Variant> variants() {
-  const std::vector<std::pair<std::string, ParameterValue>> elastic = {
-      {"Density", 2.0}, {"Shear modulus", 3.6}, {"Lame lambda", 14.0}};
-  auto with = [&](std::vector<std::pair<std::string, ParameterValue>> extra) {
-    auto v = elastic;
-    v.insert(v.end(), extra.begin(), extra.end());
-    return v;
-  };
-  std::vector<Variant> out;
-  for (std::string update : {"paper", "spd", "f_e"})
-    for (std::string convention : {"paper", "physical"})
-      out.push_back({"oldroyd_b_" + update + "_" + convention, "oldroyd_b",
-                     with({{"Strain update", update}, {"Viscosity convention", convention},
-                           {"Newtonian viscosity", 0.3}, {"Weissenberg number", 0.8}})});
-  for (double h : {0.5, 1.0, 2.0})
-    out.push_back({"herschel_bulkley_h" + std::to_string(h), "herschel_bulkley",
-                   with({{"Yield stress", 0.3}, {"Plastic viscosity", 0.7}, {"Flow index", h},
-                         {"Newtonian viscosity", 0.2}})});
-  out.push_back({"bingham", "bingham", with({{"Yield stress", 0.2}, {"Plastic viscosity", 0.5}})});
-  out.push_back({"neo_hookean", "neo_hookean", elastic});
-  out.push_back({"neo_hookean_negative_lambda", "neo_hookean", with({{"Lame lambda", -1.5}})});
-  for (double zeta : {10.0, -5.0})
-    out.push_back({"svd_plasticity_zeta" + std::to_string(zeta), "svd_plasticity",
-                   with({{"Critical compression", 0.1}, {"Critical stretch", 0.05}, {"Hardening coefficient", zeta}})});
-  out.push_back({"von_mises", "von_mises", with({{"Yield stress", 0.5}, {"Hardening modulus", 2.0}})});
-  return out;
-}
+using Variant = testkit::ModelVariant;
+std::vector<Variant> variants() { return testkit::model_variants(); }
 
 void PrintTo(const Variant& v, std::ostream* os) { *os << v.label; }
 
-std::unique_ptr<Material> build(const Variant& v) {
-  const ModelEntry* entry = find_model(v.model);
-  EXPECT_NE(entry, nullptr) << v.model;
-  ParameterValues values;
-  for (const auto& spec : entry->parameters) values.set(spec.name, spec.default_value);
-  for (const auto& [name, value] : v.values) {
-    bool declared = false;
-    for (const auto& spec : entry->parameters) declared |= spec.name == name;
-    EXPECT_TRUE(declared) << v.model << " has no parameter " << name;
-    values.set(name, value);
-  }
-  return entry->create("test", values);
-}
+std::unique_ptr<Material> build(const Variant& v) { return testkit::build_material(v, "test"); }
 
 Mat3 random_deformation(double spread) {
   Mat3 F;

@@ -1,5 +1,5 @@
 // The b_OB updates — (5.14), the positive-definite §4.6.1 and the f_e recast §4.7.1 — against the
-// analytic Oldroyd-B solutions of DESIGN.md §3 under a prescribed velocity gradient: start-up of
+// analytic Oldroyd-B solutions of doc/numerics.md under a prescribed velocity gradient: start-up of
 // simple shear and relaxation after a step strain. Each update is first order in time, so the
 // error must halve with Δt.
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Particle migration moves every particle to its owner with nothing lost or duplicated (ids,
-// count, mass and momentum conserved), under block decompositions and under the RCB boxes of
-// rebalancing, which also evens out a skewed distribution.
+// count, mass and momentum conserved) under block decompositions. Registered on 2 and 4 ranks
+// (on one rank nothing moves); the RCB boxes of rebalancing are tested in test_rcb_partition.
 #include <gtest/gtest.h>
 
 #include <numeric>
@@ -9,7 +9,6 @@
 
 #include "gather.hpp"
 #include "viscompm/parallel/migration.hpp"
-#include "viscompm/parallel/rcb_partition.hpp"
 
 using namespace viscompm;
 
@@ -59,7 +58,7 @@ particles::ParticleSet random_particles(const parallel::Communicator& comm, cons
 }
 }  // namespace
 
-TEST(Migration, ConservesEveryParticleUnderBlockAndRcbDecompositions) {
+TEST(Migration, ConservesEveryParticleUnderBlockDecompositions) {
   const parallel::Communicator comm(MPI_COMM_WORLD);
   grid::GridGeometry g;
   g.dx = 0.1;
@@ -67,9 +66,13 @@ TEST(Migration, ConservesEveryParticleUnderBlockAndRcbDecompositions) {
   particles::ParticleSet ps = random_particles(comm, g, 5000, Vec3(2, 2, 2), Vec3(22, 16, 10));
   const Totals start = totals(ps, comm);
   const auto ids_before = testkit::gather_particles(ps, comm.comm());
+  // Particles sent between ranks, all ranks: the test sees a loss only if something moves.
+  auto migrate = [&](const parallel::Decomposition& d) {
+    return comm.sum(static_cast<std::int64_t>(parallel::migrate_particles(comm, d, g, grid::KernelOrder::quadratic, ps)));
+  };
 
   const parallel::BlockDecomposition blocks(g, comm.size());
-  parallel::migrate_particles(comm, blocks, g, grid::KernelOrder::quadratic, ps);
+  EXPECT_GT(migrate(blocks), 0);
   expect_conserved(start, totals(ps, comm));
   expect_on_owners(ps, blocks, g, comm);
 
@@ -77,14 +80,9 @@ TEST(Migration, ConservesEveryParticleUnderBlockAndRcbDecompositions) {
   std::mt19937 rng(11 + comm.rank());
   std::uniform_real_distribution<double> u(-2.0, 2.0);
   for (Vec3& x : ps.position) x += g.dx * Vec3(u(rng), u(rng), u(rng));
-  parallel::migrate_particles(comm, blocks, g, grid::KernelOrder::quadratic, ps);
+  EXPECT_GT(migrate(blocks), 0);
   expect_conserved(start, totals(ps, comm));
   expect_on_owners(ps, blocks, g, comm);
-
-  const auto rcb = parallel::make_rcb_decomposition(comm, g, ps);
-  parallel::migrate_particles(comm, *rcb, g, grid::KernelOrder::quadratic, ps);
-  expect_conserved(start, totals(ps, comm));
-  expect_on_owners(ps, *rcb, g, comm);
 
   // The same ids, each once (gather_particles throws on a duplicate).
   const auto ids_after = testkit::gather_particles(ps, comm.comm());
@@ -92,19 +90,3 @@ TEST(Migration, ConservesEveryParticleUnderBlockAndRcbDecompositions) {
   for (const auto& [id, state] : ids_before) EXPECT_EQ(ids_after.count(id), 1u) << id;
 }
 
-TEST(Migration, RcbBoxesBalanceASkewedDistribution) {
-  const parallel::Communicator comm(MPI_COMM_WORLD);
-  grid::GridGeometry g;
-  g.dx = 0.05;
-  g.cells = Int3(40, 40, 40);
-  // Everything in one corner: the block decomposition gives it to one rank.
-  particles::ParticleSet ps = random_particles(comm, g, 20000, Vec3(2, 2, 2), Vec3(14, 18, 16));
-  const parallel::BlockDecomposition blocks(g, comm.size());
-  parallel::migrate_particles(comm, blocks, g, grid::KernelOrder::quadratic, ps);
-  const double skewed = parallel::imbalance(comm, ps.size());
-  const auto rcb = parallel::make_rcb_decomposition(comm, g, ps);
-  parallel::migrate_particles(comm, *rcb, g, grid::KernelOrder::quadratic, ps);
-  const double balanced = parallel::imbalance(comm, ps.size());
-  if (comm.size() > 1) EXPECT_GT(skewed, 1.5);
-  EXPECT_LT(balanced, 1.15) << "from " << skewed;
-}

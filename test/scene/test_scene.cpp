@@ -27,13 +27,16 @@ std::string read_text(const std::string& file) {
   return s.str();
 }
 
-// The default scene with `from` replaced by `to`, written next to the original (so the relative
-// solver path still resolves).
+// The default scene with `from` replaced by `to`, written to the temporary directory (its solver
+// file made absolute, so that it still resolves).
 std::string variant(const std::string& from, const std::string& to) {
   std::string text = read_text(default_scene);
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   text.replace(at, from.size(), to);
+  const std::string relative_solver = "value=\"../solvers/";
+  if (const auto solver = text.find(relative_solver); solver != std::string::npos)
+    text.replace(solver, relative_solver.size(), "value=\"" + inputs + "/solvers/");
   const std::string file = std::filesystem::temp_directory_path() / ("viscompm_scene_" + std::to_string(::getpid()) + ".xml");
   std::ofstream(file) << text;
   return file;
@@ -188,16 +191,67 @@ TEST(CommandLine, AcceptsTheContractForms) {
                         "--set=C/D=2", "--solver", "s.xml"};
   const auto cl = scene::parse_command_line(10, argv, scene::ProgramOptions{"viscompm", "test"});
   EXPECT_EQ(cl.input_file, "scene.xml");
-  EXPECT_EQ(cl.solver_file, "s.xml");
-  ASSERT_EQ(cl.overrides.size(), 4u);
+  ASSERT_EQ(cl.overrides.size(), 5u);
   EXPECT_EQ(cl.overrides[0].path, "A/B");
   EXPECT_EQ(cl.overrides[1].value, "2");
   EXPECT_EQ(cl.overrides[2].path, "Output/Directory");
   EXPECT_EQ(cl.overrides[3].path, "Simulation/Frames");
+  EXPECT_EQ(cl.overrides[4].path, "Solver/File");
+  EXPECT_EQ(cl.overrides[4].value, (std::filesystem::current_path() / "s.xml").string());
   const char* bad[] = {"viscompm", "scene.xml", "--bogus=1"};
   EXPECT_THROW(scene::parse_command_line(3, bad, scene::ProgramOptions{"viscompm", "test"}), InputError);
   const char* none[] = {"viscompm"};
   EXPECT_THROW(scene::parse_command_line(1, none, scene::ProgramOptions{"viscompm", "test"}), InputError);
+}
+
+TEST(Scene, AMissingSolverFileNamesTheSceneAndTheParameter) {
+  const std::string message = read_error(default_scene, {{"Solver/File", "../solvers/no_such_solver.xml"}});
+  expect_one_line_naming(message, default_scene, "Solver/File");
+  EXPECT_NE(message.find("no_such_solver.xml"), std::string::npos) << message;
+}
+
+TEST(Scene, ValuesTeuchosCannotReadOrWouldMisreadNameTheParameter) {
+  // Teuchos would read "none" as 0 and fails on "3" as an array with a dump of its internals.
+  for (const auto& [from, to, parameter] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"\"Cell size\" type=\"double\" value=\"0.03\"", "\"Cell size\" type=\"double\" value=\"none\"", "Grid/Cell size"},
+           {"\"Gravity\" type=\"Array(double)\" value=\"{0, -9.81, 0}\"", "\"Gravity\" type=\"Array(double)\" value=\"3\"",
+            "Simulation/Gravity"},
+           {"\"Gravity\" type=\"Array(double)\" value=\"{0, -9.81, 0}\"",
+            "\"Gravity\" type=\"Array(double)\" value=\"{0, g, 0}\"", "Simulation/Gravity"},
+           {"\"Particles per cell\" type=\"int\" value=\"2\"", "\"Particles per cell\" type=\"bool\" value=\"2x\"",
+            "Bodies/sponge/Particles per cell"}}) {
+    const std::string file = variant(from, to);
+    const std::string message = read_error(file);
+    expect_one_line_naming(message, file, parameter);
+    EXPECT_NE(message.find("is not a valid"), std::string::npos) << message;
+  }
+  // The model's name of another type (found by fuzzing: it was an internal error).
+  const std::string model = variant("<Parameter name=\"Model\" type=\"string\" value=\"oldroyd_b\"/>",
+                                    "<Parameter name=\"Model\" type=\"Array(double)\" value=\"{1, 2, 3}\"/>");
+  expect_one_line_naming(read_error(model), model, "Materials/sponge/Model");
+  const std::string cut = variant("</ParameterList>", "");
+  EXPECT_NE(read_error(cut).find("not a valid XML file (XML parse error at line"), std::string::npos) << read_error(cut);
+}
+
+TEST(Scene, AGridTooFineToNumberFailsAtRead) {
+  const std::string message = read_error(default_scene, {{"Grid/Cell size", "1e-9"}});
+  expect_one_line_naming(message, default_scene, "Grid/Cell size");
+  EXPECT_NE(message.find("grid nodes"), std::string::npos) << message;
+}
+
+TEST(Scene, NonFiniteValuesSaySo) {
+  for (const char* value : {"inf", "-inf", "nan", "1e400"}) {
+    const std::string message = read_error(default_scene, {{"Materials/sponge/Weissenberg number", value}});
+    expect_one_line_naming(message, default_scene, "Materials/sponge/Weissenberg number");
+    EXPECT_NE(message.find("is not a finite number"), std::string::npos) << message;
+  }
+  const std::string file = variant("<Parameter name=\"Cell size\" type=\"double\" value=\"0.03\"/>",
+                                   "<Parameter name=\"Cell size\" type=\"double\" value=\"inf\"/>");
+  const std::string message = read_error(file);
+  expect_one_line_naming(message, file, "Grid/Cell size");
+  EXPECT_NE(message.find("is not a finite number"), std::string::npos) << message;
+  expect_one_line_naming(read_error(default_scene, {{"Simulation/Gravity", "{0, nan, 0}"}}), default_scene,
+                         "Simulation/Gravity");
 }
 
 TEST(SolverConfiguration, ValidatesBelosAndIfpack2Parameters) {
@@ -272,4 +326,83 @@ TEST(Scene, MotionsEmittersAndRegionsAreValidatedOnRead) {
   // --set reaches the new sections.
   file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>");
   EXPECT_EQ(scene::read_scene(file, {{"Emitters/tap/Mass rate", "0.25"}}).emitters[0].mass_rate, 0.25);
+}
+
+namespace {
+// The InputError message of a solver file whose Preconditioner parameters are `parameters`.
+std::string solver_error(const std::string& preconditioner, const std::string& parameters,
+                         const std::string& top = "", const std::string& krylov = "") {
+  const std::string xml = "<ParameterList name=\"s\"><Parameter name=\"Preconditioner\" type=\"string\" value=\"" +
+                          preconditioner + "\"/>" + top + "<ParameterList name=\"Krylov parameters\">" + krylov +
+                          "</ParameterList><ParameterList name=\"Preconditioner parameters\">" + parameters +
+                          "</ParameterList></ParameterList>";
+  try {
+    linalg::SolverConfiguration::from_xml(xml, "solver.xml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string parameter(const std::string& name, const std::string& type, const std::string& value) {
+  return "<Parameter name=\"" + name + "\" type=\"" + type + "\" value=\"" + value + "\"/>";
+}
+}  // namespace
+
+TEST(SolverConfiguration, EveryShippedSolverFileIsValid) {
+  int files = 0;
+  for (const std::string folder : {inputs + "/solvers", std::string(VISCOMPM_SOURCE_DIR "/bench/muelu_variants")})
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+      if (read_text(entry.path().string()).find("\"Preconditioner\"") == std::string::npos) continue;  // a study
+      EXPECT_NO_THROW(linalg::SolverConfiguration::read(entry.path().string())) << entry.path();
+      ++files;
+    }
+  EXPECT_GE(files, 12);
+}
+
+// The libraries' own lists, validators and factories answer every kind of bad solver file with one
+// line naming the file and the parameter, before anything is set up.
+TEST(SolverConfiguration, ValidatesMueLuAndIfpack2NamesTypesAndValues) {
+  const std::string ifpack2 = parameter("Ifpack2 type", "string", "RELAXATION");
+  // Ifpack2: a value its validator rejects, with the closest valid value as a hint.
+  std::string m = solver_error("Ifpack2", parameter("relaxation: type", "string", "Jacobbi"), ifpack2);
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/relaxation: type");
+  EXPECT_NE(m.find("did you mean 'Jacobi'"), std::string::npos) << m;
+  // Ifpack2: a type the factory does not know; a wrong parameter type.
+  m = solver_error("Ifpack2", "", parameter("Ifpack2 type", "string", "CHEBYCHEV"));
+  expect_one_line_naming(m, "solver.xml", "Ifpack2 type");
+  EXPECT_NE(m.find("did you mean 'CHEBYSHEV'"), std::string::npos) << m;
+  m = solver_error("Ifpack2", parameter("relaxation: sweeps", "string", "two"), ifpack2);
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/relaxation: sweeps");
+  // MueLu: a misspelled name (hint from MueLu's master list), a word where an int belongs, an
+  // unknown smoother, a bad value inside the smoother's Ifpack2 list, a value MueLu rejects.
+  m = solver_error("MueLu", parameter("smoother: typo", "string", "RELAXATION"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/smoother: typo");
+  EXPECT_NE(m.find("did you mean 'smoother: type'"), std::string::npos) << m;
+  m = solver_error("MueLu", parameter("max levels", "string", "ten"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/max levels");
+  EXPECT_NE(m.find("expected int, got string"), std::string::npos) << m;
+  m = solver_error("MueLu", parameter("smoother: type", "string", "CHEBYCHEV"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/smoother: type");
+  EXPECT_NE(m.find("did you mean 'CHEBYSHEV'"), std::string::npos) << m;
+  m = solver_error("MueLu", parameter("smoother: type", "string", "RELAXATION") +
+                                "<ParameterList name=\"smoother: params\">" +
+                                parameter("relaxation: type", "string", "Jacobbi") + "</ParameterList>");
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/smoother: params/relaxation: type");
+  m = solver_error("MueLu", parameter("multigrid algorithm", "string", "sa2"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/multigrid algorithm");
+  m = solver_error("MueLu", parameter("aggregation: type", "string", "uncopled"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/aggregation: type");
+  m = solver_error("MueLu", parameter("coarse: type", "string", "KLU3"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/coarse: type");
+  // Belos: a tolerance that would never be met, no iterations, a non-finite number.
+  m = solver_error("none", "", "", parameter("Convergence Tolerance", "double", "-1e-6"));
+  expect_one_line_naming(m, "solver.xml", "Krylov parameters/Convergence Tolerance");
+  m = solver_error("none", "", "", parameter("Maximum Iterations", "int", "0"));
+  expect_one_line_naming(m, "solver.xml", "Krylov parameters/Maximum Iterations");
+  m = solver_error("none", "", "", parameter("Convergence Tolerance", "double", "nan"));
+  EXPECT_NE(m.find("is not a finite number"), std::string::npos) << m;
+  // Parameters for a preconditioner that takes none.
+  expect_one_line_naming(solver_error("none", parameter("relaxation: type", "string", "Jacobi")), "solver.xml",
+                         "Preconditioner parameters");
 }

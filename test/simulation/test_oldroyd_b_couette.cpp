@@ -1,6 +1,6 @@
 // A full MPM Couette flow of the Chapter 5 Oldroyd-B fluid: the fluid between two sticky plates
 // moving in opposite directions at ±V. In steady simple shear at rate γ̇ the Oldroyd-B strain is
-// b_xy = γ̇ Wi, b_xx = 1 + 2 (γ̇ Wi)², b_yy = b_zz = 1 (DESIGN.md §3, the t → ∞ limit of start-up
+// b_xy = γ̇ Wi, b_xx = 1 + 2 (γ̇ Wi)², b_yy = b_zz = 1 (doc/numerics.md, the t → ∞ limit of start-up
 // shear), reached here after 8 Wi. A sticky wall sits where its grid nodes are, and the free nodes
 // next to it miss half the particles of their support, so across a gap of 6 cells the mean rate
 // is some 10 % below the nominal 2V/H and the profile is not exactly linear (a purely viscous

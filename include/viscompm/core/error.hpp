@@ -1,4 +1,5 @@
-// The two ways a run ends early, mapped to the exit codes of the CLI contract (DESIGN.md §4).
+// The ways a run ends early, mapped to the exit codes of the command-line contract
+// (doc/contracts.md).
 #pragma once
 
 #include <stdexcept>
@@ -13,8 +14,8 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The simulation cannot continue (Newton failed at the smallest time step, NaN, ...).
-/// Frames already written stay intact. Exit code 3.
+/// The simulation cannot continue (a step failed at the smallest time step, a write failed, ...).
+/// Frames and checkpoints already written stay intact. Exit code 3.
 class SimulationError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -23,5 +24,7 @@ class SimulationError : public std::runtime_error {
 inline constexpr int exit_success = 0;
 inline constexpr int exit_bad_input = 2;
 inline constexpr int exit_simulation_failed = 3;
+/// Stopped on request (SIGTERM, SIGINT) after writing a checkpoint: --restart continues.
+inline constexpr int exit_interrupted = 4;
 
 }  // namespace viscompm

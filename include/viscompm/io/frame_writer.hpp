@@ -1,4 +1,4 @@
-// Output of DESIGN.md §4: DIR/frame_NNNNN.h5 (one file per frame whatever the rank count,
+// The output of a run (doc/contracts.md): DIR/frame_NNNNN.h5 (one file per frame whatever the rank count,
 // written collectively with parallel HDF5, to a temporary name renamed when complete) and
 // DIR/particles.xdmf, the index ParaView opens.
 #pragma once
@@ -45,7 +45,8 @@ FrameInfo write_frame(const std::string& directory, FrameInfo info, const partic
 /// The material names in material_id order, comma-separated (an attribute of /particles).
 std::string material_names(const materials::MaterialList& materials);
 
-/// Rewrites DIR/particles.xdmf for `frames` (rank 0 only; temporary name, then rename).
+/// Rewrites DIR/particles.xdmf for `frames` (rank 0 only; temporary name, then rename, so that a
+/// failed write leaves the previous index). Throws SimulationError if it cannot be written.
 void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& frames);
 
 }  // namespace viscompm::io

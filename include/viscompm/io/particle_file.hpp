@@ -36,11 +36,16 @@ struct Table {
   std::vector<std::int64_t> integers;
 };
 
-/// Writes `particles` (this rank's rows, in rank order) to `path`; returns the global count.
+/// Writes `particles` (this rank's rows, in rank order) to `path` (collective), through PATH.tmp
+/// renamed when complete, with `tables` (rank 0's rows); returns the global count. If any rank fails to write, every rank throws
+/// SimulationError and `path` is left as it was.
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
                                  const std::string& material_names, const parallel::Communicator& comm,
                                  const std::vector<Table>& tables = {});
+
+/// Why writing `path` may have failed: its directory missing or read-only, the disk full, ...
+std::string write_failure_reason(const std::string& path);
 
 /// The root attributes and particle count of a file, read without its datasets (any rank alone).
 FileAttributes read_file_attributes(const std::string& path, std::int64_t& particle_count);

@@ -1,4 +1,4 @@
-// DIR/solver.csv: one row per linear solve (DESIGN.md §4), written by rank 0.
+// DIR/solver.csv: one row per linear solve (doc/contracts.md), written by rank 0.
 #pragma once
 
 #include <cstdint>
@@ -18,10 +18,14 @@ class SolverLog {
   /// Opens DIR/solver.csv on rank 0 (append keeps earlier rows, e.g. after a restart).
   SolverLog(const std::string& directory, bool is_root, int ranks, bool append = false);
   void record(std::int64_t step, int newton_iteration, const linalg::LinearSolveReport& report);
+  /// False on rank 0 once opening or writing the file failed (the caller agrees across ranks).
+  bool good() const { return !is_root_ || static_cast<bool>(out_); }
+  const std::string& path() const { return path_; }
 
  private:
   bool is_root_;
   int ranks_;
+  std::string path_;
   std::ofstream out_;
 };
 

@@ -3,7 +3,7 @@
 //   paper: the upper-convected scheme (5.14), linear in A;
 //   spd:   the update of §4.6.1, b_OB symmetric positive definite for every Δt (quadratic in A);
 //   f_e:   the recast of §4.7.1, which stores f_e and b_OB = f_e f_e^T (quadratic in A);
-// plus the Newtonian viscous potential (5.11) in one of two conventions (DESIGN.md §3):
+// plus the Newtonian viscous potential (5.11) in one of two conventions (doc/numerics.md):
 //   paper:    Φ^N = μ^N ε̂:ε̂ V^n        (μ^N acts as a viscosity μ^N / Δt)
 //   physical: Φ^N = Δt η ε̂:ε̂ V^n       (σ^N = 2 η ε, independent of Δt)
 #pragma once

@@ -1,6 +1,6 @@
 // Parameters several models share, declared once here: the density and Lamé parameters of every
 // model, with the check that they describe a stable material (μ ≥ 0 and a positive bulk modulus
-// λ + 2μ/3), and the Newtonian viscosity of (5.11) with its convention (DESIGN.md §3).
+// λ + 2μ/3), and the Newtonian viscosity of (5.11) with its convention (doc/numerics.md).
 #pragma once
 
 #include <algorithm>

@@ -30,22 +30,13 @@ class BlockDecomposition : public Decomposition {
   /// `ranks` into three factors with the smallest block surface, and cuts are even.
   BlockDecomposition(const grid::GridGeometry& geometry, int ranks);
 
-  int ranks() const { return ranks_; }
-  const Int3& process_grid() const { return process_grid_; }
   /// Rank owning node ijk (clamped to the grid).
   int owner_of_node(const Int3& ijk) const override;
   std::string describe() const override;
-  /// The half-open node range [lower, upper) owned by `rank`.
-  void owned_block(int rank, Int3& lower, Int3& upper) const;
-  /// Cut positions along dimension d: process slice a owns nodes [cuts[a], cuts[a+1]).
-  const std::vector<int>& cuts(int d) const { return cuts_[d]; }
-  /// Replaces the cuts of dimension d (used by rebalancing). Must stay increasing.
-  void set_cuts(int d, std::vector<int> cuts);
 
  private:
   int slice_of(int d, int node) const;
 
-  int ranks_;
   Int3 nodes_;
   Int3 process_grid_;
   std::array<std::vector<int>, 3> cuts_;
@@ -58,7 +49,7 @@ namespace viscompm::parallel {
 /// Ownership by disjoint boxes in space, one per rank (box r belongs to rank r): a node belongs
 /// to the closed box that contains its position, else to the nearest box (lowest rank on a tie;
 /// empty boxes own nothing). Boxes come from a recursive coordinate bisection of
-/// the particles (make_rcb_decomposition, Zoltan2) and are stored in checkpoints.
+/// the particles (linalg::make_rcb_decomposition, Zoltan2) and are stored in checkpoints.
 class BoxDecomposition : public Decomposition {
  public:
   struct Box {

@@ -42,8 +42,6 @@ struct ParticleSet {
   void resize(std::size_t n);
   /// Keeps particle order[k] at position k (order may be a subset: the rest is dropped).
   void permute(const std::vector<std::size_t>& order);
-  /// Appends particle p of `other`.
-  void append_from(const ParticleSet& other, std::size_t p);
 
  private:
   template <class Self, class F>

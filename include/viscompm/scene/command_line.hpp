@@ -1,4 +1,4 @@
-// Command lines of the programs (DESIGN.md §4), parsed with Teuchos::CommandLineProcessor:
+// Command lines of the programs (doc/contracts.md), parsed with Teuchos::CommandLineProcessor:
 //   PROGRAM INPUT.xml [--output DIR] [--frames N] [--solver SOLVER.xml] [--set "Path=value"]...
 //           [--restart CHECKPOINT.h5] [--help]
 // "--option value" and "--option=value" are both accepted; --set may repeat.
@@ -13,9 +13,8 @@ namespace viscompm::scene {
 
 struct CommandLine {
   std::string input_file;               ///< the scene (or study) XML
-  std::string solver_file;              ///< --solver, empty if not given
   std::string restart_file;             ///< --restart, empty if not given
-  std::vector<Override> overrides;      ///< --set, then --output and --frames as overrides
+  std::vector<Override> overrides;      ///< --set, then --output, --frames and --solver as overrides
   bool help = false;
   std::string help_text;                ///< filled when help is true
 };

@@ -12,7 +12,7 @@
 //               keyframes), surface velocity
 //   Emitters    one sublist per emitter: nozzle shape, material, velocity, mass rate, times
 //   Regions     one sublist per material region: body, material, shape
-//   Output      directory
+//   Output      directory, checkpoints, MatrixMarket dumps, surfaces
 #pragma once
 
 #include <memory>
@@ -31,6 +31,8 @@ struct SimulationSettings {
   double cfl = 0.5;
   double max_time_step = 1e-2;
   double min_time_step = 1e-7;
+  double time_step_growth = 1.5;     ///< the Δt cap grows by this factor per successful step
+  double time_step_reduction = 0.5;  ///< Δt of a failed step is multiplied by this before the retry
   Vec3 gravity = Vec3(0.0, -9.81, 0.0);
   std::string transfer = "apic";
   double flip_ratio = 0.95;
@@ -119,6 +121,7 @@ struct OutputSettings {
   RealList matrix_market_steps;  ///< steps whose first Newton system is written to MatrixMarket
   int checkpoint_every = 0;      ///< frames between checkpoints (0: none)
   double surface_voxel_size = 0.0;  ///< > 0: each frame's particle surface (OpenVDB) as OBJ and VDB
+  double checkpoint_wall_seconds = 0.0;  ///< wall-clock seconds between checkpoints inside frames (0: none)
   static const ParameterTable<OutputSettings>& table();
 };
 

@@ -8,7 +8,7 @@
 // steps: whole frames of a scene, once per configuration (a solver file and Newton settings),
 //   to the same Newton tolerance. Writes DIR/steps.csv (iterations, wall time and where it went)
 //   and DIR/steps.png.
-// doc/inputs.md lists the parameters; doc/contracts (README) the CSV columns.
+// doc/inputs.md lists the parameters; doc/contracts.md the CSV columns.
 #pragma once
 
 #include <iosfwd>

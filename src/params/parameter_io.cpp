@@ -1,15 +1,18 @@
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Teuchos_FileInputSource.hpp>
 #include <Teuchos_XMLParameterListHelpers.hpp>
+#include <Teuchos_XMLParameterListReader.hpp>
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
 
-namespace viscompm::scene {
+namespace viscompm::params {
 
 namespace {
 
@@ -179,12 +182,34 @@ ParameterValues read_parameters(const Teuchos::ParameterList& list, const std::v
   return values;
 }
 
+namespace {
+// A whole token as a double; strtod also reads "inf" and "nan", which the range check then names.
+bool read_real(const std::string& token, double& x) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  x = std::strtod(token.c_str(), &end);
+  return end == token.c_str() + token.size();
+}
+
+// The items of "{1, 2, 3}" or "1, 2, 3" (braces and commas are separators).
+std::vector<std::string> list_items(const std::string& text) {
+  std::string cleaned = text;
+  for (char& ch : cleaned)
+    if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
+  std::istringstream in(cleaned);
+  std::vector<std::string> items;
+  for (std::string item; in >> item;) items.push_back(item);
+  return items;
+}
+}  // namespace
+
 ParameterValue parse_value(const ParameterSpec& spec, const std::string& text) {
   std::istringstream in(text);
   switch (spec.type) {
     case ParameterSpec::Type::real: {
+      std::string token;
       double x;
-      if (in >> x && (in >> std::ws).eof()) return x;
+      if (in >> token && (in >> std::ws).eof() && read_real(token, x)) return x;
       break;
     }
     case ParameterSpec::Type::integer: {
@@ -197,30 +222,17 @@ ParameterValue parse_value(const ParameterSpec& spec, const std::string& text) {
       if (text == "false" || text == "0") return false;
       break;
     case ParameterSpec::Type::string: return text;
+    case ParameterSpec::Type::string_list: return list_items(text);
     case ParameterSpec::Type::real_list:
-    case ParameterSpec::Type::string_list: {
-      std::string cleaned = text;
-      for (char& ch : cleaned)
-        if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
-      std::istringstream v(cleaned);
-      if (spec.type == ParameterSpec::Type::string_list) {
-        StringList list;
-        for (std::string item; v >> item;) list.push_back(item);
-        return list;
-      }
-      RealList list;
-      double x;
-      while (v >> x) list.push_back(x);
-      if ((v >> std::ws).eof() && !list.empty()) return list;
-      break;
-    }
     case ParameterSpec::Type::vector3: {
-      std::string cleaned = text;
-      for (char& ch : cleaned)
-        if (ch == '{' || ch == '}' || ch == ',') ch = ' ';
-      std::istringstream v(cleaned);
-      Vec3 x;
-      if (v >> x[0] >> x[1] >> x[2] && (v >> std::ws).eof()) return x;
+      RealList list;
+      for (const auto& item : list_items(text)) {
+        double x;
+        if (!read_real(item, x)) throw InputError("cannot read '" + text + "' as " + ParameterSpec::type_name(spec.type));
+        list.push_back(x);
+      }
+      if (spec.type == ParameterSpec::Type::real_list && !list.empty()) return list;
+      if (spec.type == ParameterSpec::Type::vector3 && list.size() == 3) return Vec3(list[0], list[1], list[2]);
       break;
     }
   }
@@ -242,35 +254,92 @@ void set_entry(Teuchos::ParameterList& list, const std::string& name, const Para
       value);
 }
 
-Teuchos::RCP<Teuchos::ParameterList> valid_parameter_list(const std::vector<ParameterSpec>& specs) {
-  auto valid = Teuchos::rcp(new Teuchos::ParameterList);
-  for (const auto& spec : specs) {
-    auto validator = Teuchos::rcp(new SpecValidator(spec));
-    std::visit(
-        [&](const auto& v) {
-          using T = std::decay_t<decltype(v)>;
-          if constexpr (std::is_same_v<T, Vec3>) {
-            valid->set(spec.name, Teuchos::Array<double>(Teuchos::tuple(v[0], v[1], v[2])), spec.doc, validator);
-          } else if constexpr (std::is_same_v<T, RealList> || std::is_same_v<T, StringList>) {
-            valid->set(spec.name, Teuchos::Array<typename T::value_type>(v.begin(), v.end()), spec.doc, validator);
-          } else {
-            valid->set(spec.name, v, spec.doc, validator);
-          }
-        },
-        spec.default_value);
-  }
-  return valid;
+namespace {
+// The last non-empty line of a Teuchos exception message (its reason; the lines before name the
+// Teuchos source file and the failed test).
+std::string teuchos_reason(const std::string& message) {
+  std::istringstream in(message);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t-") != std::string::npos) last = line;
+  return last.substr(0, 160);
 }
+
+// Teuchos reads a number with atof-like leniency ("none" becomes 0): numbers must be whole
+// tokens. Empty if `value` is a valid `type` (double, int or an array of them, or any other type).
+std::string number_problem(const std::string& type, const std::string& value) {
+  const bool real = type == "double" || type == "Array(double)";
+  const bool integer = type == "int" || type == "Array(int)";
+  if (!real && !integer) return {};
+  std::vector<std::string> tokens = {value};
+  if (type.rfind("Array", 0) == 0) {
+    const auto open = value.find('{'), close = value.rfind('}');
+    if (open == std::string::npos || close == std::string::npos || close < open)
+      return "value '" + value + "' is not a valid " + type + " (e.g. {1, 2, 3})";
+    tokens = list_items(value.substr(open + 1, close - open - 1));
+    for (auto& token : tokens) token.erase(std::remove(token.begin(), token.end(), ','), token.end());
+  }
+  for (const auto& token : tokens) {
+    char* end = nullptr;
+    const std::string trimmed = token.substr(0, token.find_last_not_of(" \t") + 1);
+    if (real) std::strtod(trimmed.c_str(), &end);
+    else std::strtol(trimmed.c_str(), &end, 10);
+    if (trimmed.empty() || end != trimmed.c_str() + trimmed.size())
+      return "value '" + value + "' is not a valid " + type;
+  }
+  return {};
+}
+
+// The first <Parameter> under `xml` that Teuchos cannot turn into a value (or whose number is
+// not a whole number token), as "path/name" and the reason; false if there is none.
+bool find_bad_parameter(const Teuchos::XMLObject& xml, const std::string& path, std::string& where, std::string& why) {
+  for (int i = 0; i < xml.numChildren(); ++i) {
+    const Teuchos::XMLObject& child = xml.getChild(i);
+    const std::string name = child.hasAttribute("name") ? child.getAttribute("name") : "?";
+    if (child.getTag() == "ParameterList") {
+      if (find_bad_parameter(child, joined(path, name), where, why)) return true;
+    } else if (child.getTag() == "Parameter") {
+      const std::string problem = number_problem(child.hasAttribute("type") ? child.getAttribute("type") : "",
+                                                 child.hasAttribute("value") ? child.getAttribute("value") : "");
+      if (!problem.empty()) {
+        where = joined(path, name);
+        why = problem;
+        return true;
+      }
+      Teuchos::XMLObject alone("ParameterList");
+      alone.addChild(child);
+      try {
+        Teuchos::XMLParameterListReader().toParameterList(alone);
+      } catch (const std::exception&) {
+        const std::string type = child.hasAttribute("type") ? child.getAttribute("type") : std::string();
+        where = joined(path, name);
+        why = "value '" + (child.hasAttribute("value") ? child.getAttribute("value") : std::string()) +
+              "' is not a valid " + (type.empty() ? std::string("value (no type)") : type) +
+              (type == "bool" ? " (true or false)" : type.rfind("Array", 0) == 0 ? " (e.g. {1, 2, 3})" : "");
+        return true;
+      }
+    }
+  }
+  return false;
+}
+}  // namespace
 
 Teuchos::RCP<Teuchos::ParameterList> read_xml_file(const std::string& file) {
   if (!std::ifstream(file).good()) throw InputError(file + ": cannot open file");
+  Teuchos::XMLObject xml;
   try {
-    return Teuchos::getParametersFromXmlFile(file);
+    xml = Teuchos::FileInputSource(file).getObject();
   } catch (const std::exception& e) {
-    std::string reason = e.what();
-    std::replace(reason.begin(), reason.end(), '\n', ' ');
-    throw InputError(file + ": not a valid XML parameter list (" + reason.substr(0, 200) + ")");
+    throw InputError(file + ": not a valid XML file (" + teuchos_reason(e.what()) + ")");
+  }
+  if (xml.getTag() != "ParameterList") throw InputError(file + ": not a parameter list (<" + xml.getTag() + ">)");
+  std::string where, why;
+  if (find_bad_parameter(xml, "", where, why)) fail(file, where, why);
+  try {
+    return Teuchos::rcp(new Teuchos::ParameterList(Teuchos::XMLParameterListReader().toParameterList(xml)));
+  } catch (const std::exception& e) {
+    throw InputError(file + ": not a valid XML parameter list (" + teuchos_reason(e.what()) + ")");
   }
 }
 
-}  // namespace viscompm::scene
+}  // namespace viscompm::params

@@ -1,15 +1,16 @@
 // Zoltan2 lives in this translation unit only (its headers are slow to compile).
-#include "viscompm/parallel/rcb_partition.hpp"
+#include "viscompm/linalg/rcb_partition.hpp"
 
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <Zoltan2_BasicVectorAdapter.hpp>
 #include <Zoltan2_PartitioningProblem.hpp>
 #include <limits>
 
-namespace viscompm::parallel {
+namespace viscompm::linalg {
 
-std::unique_ptr<BoxDecomposition> make_rcb_decomposition(const Communicator& comm, const grid::GridGeometry& geometry,
-                                                         const particles::ParticleSet& particles) {
+std::unique_ptr<parallel::BoxDecomposition> make_rcb_decomposition(const parallel::Communicator& comm,
+                                                                   const grid::GridGeometry& geometry,
+                                                                   const particles::ParticleSet& particles) {
   using types = Zoltan2::BasicUserTypes<double, int, long long>;
   using adapter_type = Zoltan2::BasicVectorAdapter<types>;
   const std::size_t n = particles.size();
@@ -45,11 +46,11 @@ std::unique_ptr<BoxDecomposition> make_rcb_decomposition(const Communicator& com
     }
   MPI_Allreduce(MPI_IN_PLACE, lower.data(), 3 * ranks, MPI_DOUBLE, MPI_MIN, comm.comm());
   MPI_Allreduce(MPI_IN_PLACE, upper.data(), 3 * ranks, MPI_DOUBLE, MPI_MAX, comm.comm());
-  std::vector<BoxDecomposition::Box> result(ranks);
+  std::vector<parallel::BoxDecomposition::Box> result(ranks);
   for (int r = 0; r < ranks; ++r)
     result[r] = {Vec3(lower[3 * r], lower[3 * r + 1], lower[3 * r + 2]),
                  Vec3(upper[3 * r], upper[3 * r + 1], upper[3 * r + 2])};
-  return std::make_unique<BoxDecomposition>(geometry, std::move(result));
+  return std::make_unique<parallel::BoxDecomposition>(geometry, std::move(result));
 }
 
-}  // namespace viscompm::parallel
+}  // namespace viscompm::linalg

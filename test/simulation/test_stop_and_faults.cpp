@@ -1,0 +1,193 @@
+// A run stopped by a signal that reaches one rank only stops on every rank after the same step,
+// with a checkpoint from which --restart continues bit for bit (like a run that wrote a
+// checkpoint there and went on); wall-clock checkpoints replace each other; a step that goes non-finite is retried with a smaller Δt and, when that cannot
+// help, ends the run with SimulationError and the frames written so far intact.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <sstream>
+
+#include "gather.hpp"
+#include "scenes.hpp"
+#include "viscompm/core/error.hpp"
+#include "viscompm/io/checkpoint.hpp"
+#include "viscompm/io/frame_writer.hpp"
+#include "viscompm/io/particle_file.hpp"
+#include "viscompm/simulation/simulation.hpp"
+#include "viscompm/simulation/stop_request.hpp"
+
+using namespace viscompm;
+
+namespace {
+// The default scene, coarse, three short frames, writing into `directory`.
+scene::SceneConfig short_run(const std::string& directory) {
+  auto scene = scene::read_scene(VISCOMPM_SOURCE_DIR "/inputs/scenes/shooting_sponge.xml",
+                                 {{"Grid/Cell size", "0.06"}, {"Newton/Tolerance", "1e-10"},
+                                  {"Simulation/Frame rate", "120"}, {"Simulation/Frames", "3"}});
+  scene.output.directory = directory;
+  return scene;
+}
+
+std::string work_directory(const parallel::Communicator& comm, const std::string& name) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("viscompm_" + name + "_np" + std::to_string(comm.size()))).string();
+  if (comm.is_root()) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  comm.barrier();
+  return dir;
+}
+
+std::vector<std::string> files_starting_with(const std::string& directory, const std::string& prefix) {
+  std::vector<std::string> found;
+  for (const auto& entry : std::filesystem::directory_iterator(directory))
+    if (entry.path().filename().string().rfind(prefix, 0) == 0) found.push_back(entry.path().string());
+  return found;
+}
+
+// A model that behaves like another but writes NaN into F after steps longer than `limit`: a
+// stand-in for a constitutive update that breaks down at large steps.
+class BreaksAtLargeSteps : public materials::Material {
+ public:
+  BreaksAtLargeSteps(std::unique_ptr<materials::Material> inner, double limit)
+      : Material(inner->name()), inner_(std::move(inner)), limit_(limit) {}
+  std::string model() const override { return inner_->model(); }
+  double density() const override { return inner_->density(); }
+  double wave_speed() const override { return inner_->wave_speed(); }
+  std::vector<std::string> state_fields() const override { return inner_->state_fields(); }
+  bool evaluate(const particles::ParticleSet& ps, std::size_t p, const Mat3& A, const materials::StepContext& step,
+                int order, materials::PotentialDerivatives& out) const override {
+    return inner_->evaluate(ps, p, A, step, order, out);
+  }
+  void update_state(particles::ParticleSet& ps, std::size_t p, const Mat3& A,
+                    const materials::StepContext& step) const override {
+    inner_->update_state(ps, p, A, step);
+    if (step.dt > limit_) ps.deformation_gradient[p](0, 0) = std::numeric_limits<double>::quiet_NaN();
+  }
+  Mat3 left_cauchy_green_elastic(const particles::ParticleSet& ps, std::size_t p) const override {
+    return inner_->left_cauchy_green_elastic(ps, p);
+  }
+
+ private:
+  std::unique_ptr<materials::Material> inner_;
+  double limit_;
+};
+
+materials::MaterialList breaking_materials(const scene::SceneConfig& scene, double limit) {
+  materials::MaterialList list = simulation::make_materials(scene);
+  for (auto& m : list) m = std::make_unique<BreaksAtLargeSteps>(std::move(m), limit);
+  return list;
+}
+}  // namespace
+
+TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitForBit) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = work_directory(world, "stop");
+  const auto solver = testkit::jacobi_cg(1e-12);
+  std::ostringstream log;
+
+  // A checkpoint resets what the solver reuses across steps, as a restart starts afresh: the
+  // reference writes one after every step (wall-clock checkpoints every 1e-9 s), and so does the
+  // run that is stopped and restarted.
+  auto every_step = [](scene::SceneConfig scene) {
+    scene.output.checkpoint_wall_seconds = 1e-9;
+    return scene;
+  };
+  simulation::Simulation straight(every_step(short_run(dir + "/straight")), solver, world);
+  const auto done = straight.run(log);
+  EXPECT_EQ(done.stop_signal, 0);
+  const auto reference = testkit::gather_particles(straight.particles(), world.comm());
+
+  // SIGTERM reaches the last rank only, before the first step.
+  simulation::install_stop_handlers();
+  simulation::clear_stop_signal();
+  if (world.rank() == world.size() - 1) std::raise(SIGTERM);
+  simulation::Simulation stopped(every_step(short_run(dir + "/stopped")), solver, world);
+  const auto summary = stopped.run(log);
+  simulation::clear_stop_signal();
+  EXPECT_EQ(summary.stop_signal, SIGTERM);
+  EXPECT_EQ(stopped.step_count(), 1) << "every rank stops after the step during which the signal came";
+  EXPECT_EQ(summary.stop_checkpoint, dir + "/stopped/" + io::step_checkpoint_file_name(1));
+  EXPECT_TRUE(std::filesystem::exists(summary.stop_checkpoint));
+  EXPECT_LT(stopped.time(), 1.0 / 120.0) << "stopped inside frame 1";
+  EXPECT_TRUE(files_starting_with(dir + "/stopped", "frame_00001").empty());
+
+  simulation::Simulation continued(every_step(short_run(dir + "/stopped")), solver, world, summary.stop_checkpoint);
+  EXPECT_EQ(continued.time(), stopped.time());
+  const auto rest = continued.run(log);
+  EXPECT_EQ(rest.stop_signal, 0);
+  EXPECT_EQ(continued.step_count(), straight.step_count());
+  const auto result = testkit::gather_particles(continued.particles(), world.comm());
+  EXPECT_TRUE(testkit::bitwise_equal(reference, result)) << "difference " << testkit::max_state_difference(reference, result);
+  if (world.is_root()) EXPECT_EQ(files_starting_with(dir + "/stopped", "frame_").size(), 4u);
+}
+
+TEST(WallClockCheckpoints, EachReplacesThePreviousAndTheRunGoesOn) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = work_directory(world, "wall");
+  auto scene = short_run(dir);
+  scene.output.checkpoint_wall_seconds = 1e-9;  // after every step
+  simulation::Simulation sim(scene, testkit::jacobi_cg(1e-10), world);
+  std::ostringstream log;
+  const auto summary = sim.run(log);
+  EXPECT_EQ(summary.stop_signal, 0);
+  EXPECT_EQ(files_starting_with(dir, "frame_").size(), 4u);
+  const auto checkpoints = files_starting_with(dir, "checkpoint_step_");
+  ASSERT_EQ(checkpoints.size(), 1u) << "each wall-clock checkpoint replaces the previous one";
+  EXPECT_EQ(checkpoints[0], dir + "/" + io::step_checkpoint_file_name(sim.step_count()));
+  EXPECT_GT(sim.step_count(), 3);
+  EXPECT_NE(log.str().find("checkpoint"), world.is_root() ? std::string::npos : 0u);
+}
+
+TEST(NonFiniteSteps, AreRetriedWithASmallerTimeStep) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = work_directory(world, "nonfinite_retry");
+  const auto scene = short_run(dir);
+  simulation::Simulation plain(scene, testkit::jacobi_cg(1e-10), world);
+  simulation::RunSummary plain_summary;
+  plain.advance_to(1.0 / 120.0, plain_summary);
+  ASSERT_EQ(plain_summary.retries, 0);
+  // Steps of the plain run's length break; half as long do not.
+  const double limit = 0.7 * plain.time() / plain_summary.steps;
+
+  simulation::Simulation sim(scene, breaking_materials(scene, limit), testkit::jacobi_cg(1e-10), world);
+  simulation::RunSummary summary;
+  sim.advance_to(1.0 / 120.0, summary);
+  EXPECT_GT(summary.retries, 0) << "no step went non-finite: the test would not see a retry";
+  EXPECT_GT(summary.steps, plain_summary.steps);
+  EXPECT_EQ(sim.time(), 1.0 / 120.0);
+  bool finite = true;
+  for (std::size_t p = 0; p < sim.particles().size(); ++p)
+    finite &= sim.particles().deformation_gradient[p].allFinite() && sim.particles().position[p].allFinite();
+  EXPECT_FALSE(world.any(!finite));
+}
+
+TEST(NonFiniteSteps, EndTheRunWithTheFramesWrittenSoFarIntact) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = work_directory(world, "nonfinite_fail");
+  auto scene = short_run(dir);
+  scene.simulation.min_time_step = 1e-4;
+  simulation::Simulation sim(scene, breaking_materials(scene, 0.0), testkit::jacobi_cg(1e-10), world);  // every step
+  std::ostringstream log;
+  std::string message;
+  try {
+    sim.run(log);
+  } catch (const SimulationError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("non-finite"), std::string::npos) << message;
+  EXPECT_NE(message.find("frame 0"), std::string::npos) << message;
+  if (world.is_root()) {
+    EXPECT_EQ(files_starting_with(dir, "frame_").size(), 1u);
+    EXPECT_TRUE(files_starting_with(dir, "frame_00000.h5.tmp").empty());
+  }
+  // Frame 0 reads back whole and finite.
+  io::FileAttributes attributes;
+  const auto frame0 = io::read_particle_file(dir + "/" + io::frame_file_name(0), world, attributes);
+  EXPECT_EQ(world.sum(static_cast<std::int64_t>(frame0.size())), world.sum(static_cast<std::int64_t>(sim.particles().size())));
+  bool finite = true;
+  for (std::size_t p = 0; p < frame0.size(); ++p) finite &= frame0.deformation_gradient[p].allFinite();
+  EXPECT_FALSE(world.any(!finite));
+}
