@@ -46,16 +46,6 @@ double total_mass(const particles::ParticleSet& ps, const parallel::Communicator
   return comm.sum(m);
 }
 
-std::string work_directory(const parallel::Communicator& comm, const std::string& name) {
-  const std::string dir =
-      (std::filesystem::temp_directory_path() / ("viscompm_" + name + "_np" + std::to_string(comm.size()))).string();
-  if (comm.is_root()) {
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-  }
-  comm.barrier();
-  return dir;
-}
 }  // namespace
 
 TEST(Emitters, DeliverThePrescribedMassAtThePrescribedVelocity) {
@@ -105,7 +95,7 @@ TEST(Emitters, DeliverThePrescribedMassAtThePrescribedVelocity) {
 TEST(Emitters, ARestartInTheMiddleOfTheEmissionContinuesBitForBitWithUniqueIds) {
   const parallel::Communicator comm(MPI_COMM_WORLD);
   auto scene = emitter_scene();
-  scene.output.directory = work_directory(comm, "emitter_restart");
+  scene.output.directory = testkit::work_directory(comm, "emitter_restart");
   const auto solver = testkit::jacobi_cg(1e-12);
   simulation::Simulation straight(scene, solver, comm);
   simulation::RunSummary summary;

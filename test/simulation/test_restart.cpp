@@ -24,20 +24,11 @@ scene::SceneConfig restart_scene(const std::string& directory) {
   return scene;
 }
 
-std::string work_directory(const parallel::Communicator& comm, const std::string& name) {
-  const std::string dir = (std::filesystem::temp_directory_path() / ("viscompm_" + name + "_np" + std::to_string(comm.size()))).string();
-  if (comm.is_root()) {
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-  }
-  comm.barrier();
-  return dir;
-}
 }  // namespace
 
 TEST(Restart, ContinuesBitForBitOnTheSameRankCountAndToToleranceOnOne) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const std::string dir = work_directory(world, "restart");
+  const std::string dir = testkit::work_directory(world, "restart");
   const auto scene = restart_scene(dir);
   const auto solver = testkit::jacobi_cg(1e-12);
   const double t_checkpoint = 2.0 / scene.simulation.frame_rate, t_end = 4.0 / scene.simulation.frame_rate;
@@ -70,7 +61,7 @@ TEST(Restart, ContinuesBitForBitOnTheSameRankCountAndToToleranceOnOne) {
 
 TEST(Restart, AFileWrittenByAllRanksIsReadBackIdenticallyByOne) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const std::string dir = work_directory(world, "readback");
+  const std::string dir = testkit::work_directory(world, "readback");
   const auto scene = restart_scene(dir);
   simulation::Simulation sim(scene, testkit::jacobi_cg(1e-10), world);
   simulation::RunSummary summary;

@@ -29,16 +29,6 @@ scene::SceneConfig short_run(const std::string& directory) {
   return scene;
 }
 
-std::string work_directory(const parallel::Communicator& comm, const std::string& name) {
-  const std::string dir =
-      (std::filesystem::temp_directory_path() / ("viscompm_" + name + "_np" + std::to_string(comm.size()))).string();
-  if (comm.is_root()) {
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-  }
-  comm.barrier();
-  return dir;
-}
 
 std::vector<std::string> files_starting_with(const std::string& directory, const std::string& prefix) {
   std::vector<std::string> found;
@@ -84,7 +74,7 @@ materials::MaterialList breaking_materials(const scene::SceneConfig& scene, doub
 
 TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitForBit) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const std::string dir = work_directory(world, "stop");
+  const std::string dir = testkit::work_directory(world, "stop");
   const auto solver = testkit::jacobi_cg(1e-12);
   std::ostringstream log;
 
@@ -126,7 +116,7 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
 
 TEST(WallClockCheckpoints, EachReplacesThePreviousAndTheRunGoesOn) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const std::string dir = work_directory(world, "wall");
+  const std::string dir = testkit::work_directory(world, "wall");
   auto scene = short_run(dir);
   scene.output.checkpoint_wall_seconds = 1e-9;  // after every step
   simulation::Simulation sim(scene, testkit::jacobi_cg(1e-10), world);
@@ -143,7 +133,7 @@ TEST(WallClockCheckpoints, EachReplacesThePreviousAndTheRunGoesOn) {
 
 TEST(NonFiniteSteps, AreRetriedWithASmallerTimeStep) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const std::string dir = work_directory(world, "nonfinite_retry");
+  const std::string dir = testkit::work_directory(world, "nonfinite_retry");
   const auto scene = short_run(dir);
   simulation::Simulation plain(scene, testkit::jacobi_cg(1e-10), world);
   simulation::RunSummary plain_summary;
@@ -166,7 +156,7 @@ TEST(NonFiniteSteps, AreRetriedWithASmallerTimeStep) {
 
 TEST(NonFiniteSteps, EndTheRunWithTheFramesWrittenSoFarIntact) {
   const parallel::Communicator world(MPI_COMM_WORLD);
-  const std::string dir = work_directory(world, "nonfinite_fail");
+  const std::string dir = testkit::work_directory(world, "nonfinite_fail");
   auto scene = short_run(dir);
   scene.simulation.min_time_step = 1e-4;
   simulation::Simulation sim(scene, breaking_materials(scene, 0.0), testkit::jacobi_cg(1e-10), world);  // every step

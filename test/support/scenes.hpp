@@ -1,12 +1,14 @@
 // Scenes built in code for the tests (the same structs read_scene fills).
 #pragma once
 
+#include <filesystem>
 #include <sstream>
 #include <string>
 
 #include "viscompm/linalg/linear_solver.hpp"
 #include "viscompm/materials/oldroyd_b.hpp"
 #include "viscompm/materials/registry.hpp"
+#include "viscompm/parallel/communicator.hpp"
 #include "viscompm/scene/scene.hpp"
 
 namespace viscompm::testkit {
@@ -160,6 +162,18 @@ inline scene::SceneConfig mixed_models_scene() {
   scene.bodies.push_back(cream);
   scene.colliders.push_back(box_collider("table", "sticky", Vec3(0.0, 0.0, 0.0), Vec3(1.2, 0.2, 0.5)));
   return scene;
+}
+
+// A fresh, empty directory viscompm_NAME_npN under the system's temporary directory (collective).
+inline std::string work_directory(const parallel::Communicator& comm, const std::string& name) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("viscompm_" + name + "_np" + std::to_string(comm.size()))).string();
+  if (comm.is_root()) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  comm.barrier();
+  return dir;
 }
 
 }  // namespace viscompm::testkit
