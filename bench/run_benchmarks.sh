@@ -67,4 +67,22 @@ if [[ -n "${BASELINE_BIN:-}" ]]; then
     done
   done
 fi
+
+# 11. The geometric hierarchy's reuse inside MueLu (RAP against none), 6 frames of the demo.
+sed 's|<Parameter name="reuse: type" type="string" value="RAP"/>|<Parameter name="reuse: type" type="string" value="none"/>|; s|value="gmg-chebyshev"|value="gmg-chebyshev-no-reuse"|' \
+  "$ROOT/inputs/solvers/gmg_cg.xml" > "$OUT/gmg_no_reuse.xml"
+for solver in "$ROOT/inputs/solvers/gmg_cg.xml" "$OUT/gmg_no_reuse.xml"; do
+  name=$(basename "$solver" .xml)
+  mpiexec -np 2 "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --frames 6 --solver "$solver" \
+    --output "$OUT/reuse_$name" | tee "$OUT/reuse_$name.txt"
+done
+
+# 12. The demo's padding and Newton strategy: Padding lookahead 0 and 2 (8 is the default), and
+#     inexact Newton.
+for la in 0 2; do
+  mpiexec -np 2 "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --set "Grid/Padding lookahead=$la" \
+    --output "$OUT/demo_la${la}_np2" > "$OUT/demo_la${la}_np2.txt"
+done
+mpiexec -np 2 "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --set "Newton/Linear tolerance=eisenstat-walker" \
+  --output "$OUT/demo_ew_np2" > "$OUT/demo_ew_np2.txt"
 echo "benchmarks in $OUT"
