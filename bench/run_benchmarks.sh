@@ -24,14 +24,19 @@ mpiexec -np 1 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_preconditioners
 # 3. §5.7's Jacobi factor during the impact.
 mpiexec -np 2 "$BIN/viscompm-study" "$ROOT/inputs/studies/sponge_jacobi_factor.xml" --output "$OUT/jacobi_factor" | tee "$OUT/jacobi_factor.txt"
 
-# 4. MueLu reuse across Newton iterations and steps, on 6 frames of the default scene.
-sed 's|<Parameter name="reuse: type" type="string" value="tP"/>|<Parameter name="reuse: type" type="string" value="none"/>|; s|value="muelu-sa"|value="muelu-sa-no-reuse"|' \
-  "$ROOT/inputs/solvers/muelu_cg.xml" > "$OUT/muelu_no_reuse.xml"
-for solver in "$ROOT/inputs/solvers/muelu_cg.xml" "$OUT/muelu_no_reuse.xml"; do
-  name=$(basename "$solver" .xml)
-  mpiexec -np 1 "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --frames 6 --solver "$solver" \
-    --output "$OUT/reuse_$name" | tee "$OUT/reuse_$name.txt"
-done
+# 4. MueLu reuse across Newton iterations and steps, on 6 frames of the default scene: the shipped
+#    solver file against a copy with `reuse: type = none`. Usage: reuse_pair FILE REUSE LABEL RANKS
+reuse_pair() {
+  local file="$ROOT/inputs/solvers/$1.xml" no_reuse="$OUT/$1_no_reuse.xml"
+  sed "s|<Parameter name=\"reuse: type\" type=\"string\" value=\"$2\"/>|<Parameter name=\"reuse: type\" type=\"string\" value=\"none\"/>|; s|value=\"$3\"|value=\"$3-no-reuse\"|" \
+    "$file" > "$no_reuse"
+  for solver in "$file" "$no_reuse"; do
+    name=$(basename "$solver" .xml)
+    mpiexec -np "$4" "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --frames 6 --solver "$solver" \
+      --output "$OUT/reuse_$name" | tee "$OUT/reuse_$name.txt"
+  done
+}
+reuse_pair muelu_cg tP muelu-sa 1
 
 # 5. Strong scaling of the default scene (the demo) on 1 and 2 ranks.
 for n in 1 2; do
@@ -69,13 +74,7 @@ if [[ -n "${BASELINE_BIN:-}" ]]; then
 fi
 
 # 11. The geometric hierarchy's reuse inside MueLu (RAP against none), 6 frames of the demo.
-sed 's|<Parameter name="reuse: type" type="string" value="RAP"/>|<Parameter name="reuse: type" type="string" value="none"/>|; s|value="gmg-chebyshev"|value="gmg-chebyshev-no-reuse"|' \
-  "$ROOT/inputs/solvers/gmg_cg.xml" > "$OUT/gmg_no_reuse.xml"
-for solver in "$ROOT/inputs/solvers/gmg_cg.xml" "$OUT/gmg_no_reuse.xml"; do
-  name=$(basename "$solver" .xml)
-  mpiexec -np 2 "$BIN/viscompm" "$ROOT/inputs/scenes/shooting_sponge.xml" --frames 6 --solver "$solver" \
-    --output "$OUT/reuse_$name" | tee "$OUT/reuse_$name.txt"
-done
+reuse_pair gmg_cg RAP gmg-chebyshev 2
 
 # 12. The demo's padding and Newton strategy: Padding lookahead 0 and 2 (8 is the default), and
 #     inexact Newton.
