@@ -36,4 +36,5 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_
 # VISCOMPM_CMAKE_ARGS: extra configure options (scripts/test.sh --sanitize sets VISCOMPM_SANITIZE).
 # shellcheck disable=SC2086
 cmake -S "$VISCOMPM_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release ${VISCOMPM_CMAKE_ARGS:-} >/dev/null
-cmake --build "$BUILD_DIR" -j "$JOBS"
+# VISCOMPM_BUILD_TARGET: one target instead of all (scripts/test.sh --no-trilinos sets it).
+cmake --build "$BUILD_DIR" -j "$JOBS" ${VISCOMPM_BUILD_TARGET:+--target "$VISCOMPM_BUILD_TARGET"}

@@ -6,12 +6,18 @@
 #   scripts/test.sh --sanitize [-L ..]  build-sanitize/ with AddressSanitizer and
 #                                       UndefinedBehaviorSanitizer, leaks checked, the known leaks
 #                                       of MPI and Trilinos suppressed (scripts/sanitizers/)
+#   scripts/test.sh --no-trilinos       only the tests of the physics layer (label no_trilinos),
+#                                       building only them: with --sanitize, what .ci/run adds
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ctest_args=()
 sanitize=0
 for argument in "$@"; do
-  if [ "$argument" = "--sanitize" ]; then sanitize=1; else ctest_args+=("$argument"); fi
+  case "$argument" in
+    --sanitize) sanitize=1 ;;
+    --no-trilinos) export VISCOMPM_BUILD_TARGET=no_trilinos_tests; ctest_args+=(-L no_trilinos) ;;
+    *) ctest_args+=("$argument") ;;
+  esac
 done
 if [ "$sanitize" = 1 ]; then
   export VISCOMPM_BUILD_DIR="${VISCOMPM_BUILD_DIR:-$here/../build-sanitize}"

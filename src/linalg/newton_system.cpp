@@ -56,15 +56,15 @@ void NewtonSystem::Impl::build_near_nullspace() {
 
 void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
   auto view = owned.getLocalViewHost(Tpetra::Access::OverwriteAll);
-  const double* data = field.data()->data();
-  for (std::size_t r = 0; r < 3 * space.impl().owned_count; ++r) view(r, 0) = data[r];
+  for (std::size_t i = 0; i < space.impl().owned_count; ++i)
+    for (int c = 0; c < 3; ++c) view(3 * i + c, 0) = field[i][c];
 }
 
 void NewtonSystem::Impl::from_owned(const multivector_type& owned, NodeVectorField& field) const {
   field.assign(space.impl().local_count, Vec3::Zero());
   auto view = owned.getLocalViewHost(Tpetra::Access::ReadOnly);
-  double* data = field.data()->data();
-  for (std::size_t r = 0; r < 3 * space.impl().owned_count; ++r) data[r] = view(r, 0);
+  for (std::size_t i = 0; i < space.impl().owned_count; ++i)
+    for (int c = 0; c < 3; ++c) field[i][c] = view(3 * i + c, 0);
   space.import_ghosts(field);
 }
 

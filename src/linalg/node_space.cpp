@@ -63,14 +63,14 @@ void NodeSpace::import_ghosts(NodeVectorField& field) const {
   vector_type owned(s.owned_dof_map), column(s.column_dof_map);
   {
     auto view = owned.getLocalViewHost(Tpetra::Access::OverwriteAll);
-    const double* data = field.data()->data();
-    for (std::size_t r = 0; r < 3 * s.owned_count; ++r) view(r, 0) = data[r];
+    for (std::size_t i = 0; i < s.owned_count; ++i)
+      for (int c = 0; c < 3; ++c) view(3 * i + c, 0) = field[i][c];
   }
   column.doImport(owned, *s.dof_import, Tpetra::INSERT);
   auto view = column.getLocalViewHost(Tpetra::Access::ReadOnly);
   field.resize(s.local_count);
-  double* data = field.data()->data();
-  for (std::size_t r = 3 * s.owned_count; r < 3 * s.local_count; ++r) data[r] = view(r, 0);
+  for (std::size_t i = s.owned_count; i < s.local_count; ++i)
+    for (int c = 0; c < 3; ++c) field[i][c] = view(3 * i + c, 0);
 }
 
 std::int64_t NodeSpace::global_node_count() const {

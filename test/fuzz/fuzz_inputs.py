@@ -215,6 +215,8 @@ with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         if outcome in ("crash", "hang", "bad"):
             failures.append(f"variant {index} ({source}: {mutation}): {outcome}: {detail}")
             print("FAIL:", failures[-1], flush=True)
+        if not args.verbose and (index + 1) % 250 == 0:
+            print(f"{index + 1} of {args.variants} variants in {time.time() - started:.0f} s", flush=True)
 elapsed = time.time() - started
 summary = ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
 print(f"{args.variants} variants (seed {args.seed}) in {elapsed:.0f} s: {summary}")

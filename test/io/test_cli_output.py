@@ -2,7 +2,6 @@
 """The viscompm program end to end, as users and scripts see it (doc/contracts.md):
 --help, exit codes with one-line messages, and the output read back with h5py: the HDF5 frame
 schema, the XDMF index ParaView opens, and solver.csv."""
-import argparse
 import csv
 import os
 import shlex
@@ -15,22 +14,12 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--viscompm", required=True)
-parser.add_argument("--ranks", type=int, default=1)
-parser.add_argument("--mpiexec", required=True)
-parser.add_argument("--inputs", required=True)
-parser.add_argument("--workdir", required=True)
-args = parser.parse_args()
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
+from script_checks import check, finish, program_arguments  # noqa: E402
+
+args = program_arguments("viscompm", ranks=1).parse_args()
 
 scene = os.path.join(args.inputs, "scenes", "shooting_sponge.xml")
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*extra):
@@ -185,5 +174,4 @@ if os.path.exists(frame0):
     with h5py.File(frame0, "r") as f:
         check(f["particles/position"].shape[0] > 0, "frame 0 is readable")
 
-print(f"{len(failures)} failure(s)")
-sys.exit(1 if failures else 0)
+finish()

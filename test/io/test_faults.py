@@ -6,7 +6,6 @@
   every file written before intact, nothing half-written left.
 - The output directory disappears during the run: exit 3, the earlier frames intact.
 - A truncated, foreign or corrupted checkpoint: exit 2 with one line naming it."""
-import argparse
 import glob
 import os
 import resource
@@ -21,26 +20,16 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--viscompm", required=True)
-parser.add_argument("--ranks", type=int, default=2)
-parser.add_argument("--mpiexec", required=True)
-parser.add_argument("--inputs", required=True)
-parser.add_argument("--workdir", required=True)
-args = parser.parse_args()
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
+from script_checks import check, finish, program_arguments  # noqa: E402
+
+args = program_arguments("viscompm", ranks=2).parse_args()
 
 scene = os.path.join(args.inputs, "scenes", "shooting_sponge.xml")
 # A checkpoint after every step (it resets what the solver reuses across steps, as a restart
 # starts afresh), so that the reference and the stopped-and-restarted runs do the same.
 small = ["--set", "Grid/Cell size=0.06", "--set", "Simulation/Frame rate=120", "--set", "Newton/Tolerance=1e-10",
          "--set", "Output/Checkpoint wall seconds=1e-9"]
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def command(*extra, ranks=None):
@@ -231,5 +220,4 @@ if good:
 else:
     check(False, "no checkpoint to corrupt")
 
-print(f"{len(failures)} failure(s)")
-sys.exit(1 if failures else 0)
+finish()

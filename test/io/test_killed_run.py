@@ -2,7 +2,6 @@
 """A run killed (SIGKILL) at arbitrary moments, some of them during output, leaves every frame
 and checkpoint it had finished readable (files are written under a temporary name and renamed
 when complete), and the last checkpoint restarts."""
-import argparse
 import glob
 import os
 import shlex
@@ -14,24 +13,14 @@ import time
 
 import h5py
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--viscompm", required=True)
-parser.add_argument("--ranks", type=int, default=2)
-parser.add_argument("--mpiexec", required=True)
-parser.add_argument("--inputs", required=True)
-parser.add_argument("--workdir", required=True)
-args = parser.parse_args()
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
+from script_checks import check, finish, program_arguments  # noqa: E402
+
+args = program_arguments("viscompm", ranks=2).parse_args()
 scene = os.path.join(args.inputs, "scenes", "shooting_sponge.xml")
 # Heavy output relative to compute: every frame a few steps long, a checkpoint every frame.
 options = ["--frames", "200", "--set", "Grid/Cell size=0.045", "--set", "Simulation/Frame rate=600",
            "--set", "Output/Checkpoint every=1"]
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 shutil.rmtree(args.workdir, ignore_errors=True)
@@ -63,5 +52,4 @@ for trial, delay in enumerate([0.0, 0.37, 0.81]):
                                                               *options[2:], "--restart", checkpoints[-1]],
                                  capture_output=True, text=True, timeout=600)
         check(restart.returncode == 0, f"trial {trial}: restart from {checkpoints[-1]} exits 0: {restart.stderr[-800:]}")
-print(f"{len(failures)} failure(s)")
-sys.exit(1 if failures else 0)
+finish()

@@ -4,7 +4,6 @@ frame rates that reach each scene's event) and its frames are sound: every store
 ids unique, the mass conserved exactly or grown by exactly what the emitters delivered (the
 frames' emitted_mass attribute), colliders written with the frames and indexed by the XDMF file.
 """
-import argparse
 import glob
 import os
 import shlex
@@ -15,6 +14,9 @@ import xml.etree.ElementTree as ET
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
+from script_checks import check, failures, finish, program_arguments  # noqa: E402
 
 # Per scene: overrides that keep the test short (seconds on 2 cores) while reaching the event.
 SETTINGS = {
@@ -27,23 +29,9 @@ SETTINGS = {
     "toothpaste": ["Simulation/Frame rate=3"],                                   # it reaches the brush
 }
 
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
-
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--viscompm", required=True)
-    ap.add_argument("--mpiexec", required=True)
-    ap.add_argument("--ranks", type=int, default=2)
-    ap.add_argument("--inputs", required=True)
-    ap.add_argument("--workdir", required=True)
-    args = ap.parse_args()
+    args = program_arguments("viscompm", ranks=2).parse_args()
     scenes = sorted(glob.glob(os.path.join(args.inputs, "scenes", "paper", "*.xml")))
     names = [os.path.splitext(os.path.basename(s))[0] for s in scenes]
     check(sorted(names) == sorted(SETTINGS), f"the paper scenes are {sorted(SETTINGS)}, found {names}")
@@ -110,10 +98,7 @@ def main():
                 check(dataset in f and f[dataset].shape == dims, f"{name}: xdmf item {item.text} {dims}")
         status = "ok" if not any(m.startswith(name) for m in failures) else "FAILED"
         print(f"{name}: {status} ({elapsed:.1f} s)")
-    if failures:
-        print(f"{len(failures)} check(s) failed")
-        sys.exit(1)
-    print("all paper scenes sound")
+    finish("all paper scenes sound")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,6 @@
 """scripts/render.sh turns a tiny run into one PNG per frame of the requested size, showing
 particles coloured around det b^E = 1 and the colliders, and a movie. Skips (exit 77) only when
 ParaView's pvbatch is not installed (scripts/setup.sh installs it)."""
-import argparse
 import os
 import shutil
 import struct
@@ -10,24 +9,14 @@ import subprocess
 import sys
 import zlib
 
-ap = argparse.ArgumentParser()
-ap.add_argument("--viscompm", required=True)
-ap.add_argument("--render", required=True)
-ap.add_argument("--inputs", required=True)
-ap.add_argument("--workdir", required=True)
-args = ap.parse_args()
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
+from script_checks import check, finish, program_arguments  # noqa: E402
+
+args = program_arguments("viscompm", "render").parse_args()
 
 if shutil.which("pvbatch") is None or shutil.which("Xvfb") is None:
     print("SKIP: pvbatch or Xvfb is not installed (scripts/setup.sh installs paraview and xvfb)")
     sys.exit(77)
-
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def read_png(path):
@@ -97,7 +86,4 @@ check(os.path.exists(movie) and os.path.getsize(movie) > 1000, f"{movie} written
 # A directory without frames is a one-line error, exit 2.
 bad = subprocess.run([args.render, os.path.join(args.workdir, "no_such_dir")], capture_output=True, text=True)
 check(bad.returncode == 2 and "no_such_dir" in bad.stderr, f"a missing directory exits 2: {bad.returncode} {bad.stderr}")
-if failures:
-    print(f"{len(failures)} check(s) failed")
-    sys.exit(1)
-print("render.sh: 3 frames of 320x180 and a movie")
+finish("render.sh: 3 frames of 320x180 and a movie")

@@ -5,7 +5,6 @@ converged=0 that keep the system's size, a Newton system written to MatrixMarket
 reproduces that run's solve when the study reads it back and every assembled solver file
 (multigrid included: the dump carries node coordinates) solves it, and the steps mode runs whole
 frames per configuration into steps.csv."""
-import argparse
 import csv
 import os
 import shlex
@@ -13,21 +12,10 @@ import shutil
 import subprocess
 import sys
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--viscompm", required=True)
-parser.add_argument("--study", required=True)
-parser.add_argument("--ranks", type=int, default=1)
-parser.add_argument("--mpiexec", required=True)
-parser.add_argument("--inputs", required=True)
-parser.add_argument("--workdir", required=True)
-args = parser.parse_args()
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
+from script_checks import check, finish, program_arguments  # noqa: E402
 
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
+args = program_arguments("viscompm", "study", ranks=1).parse_args()
 
 
 def run(program, *extra):
@@ -162,5 +150,4 @@ with open(steps_study, "w") as f:
 result = run(args.study, steps_study, "--output", out + "_bad")
 check(result.returncode == 2 and "Hessian updates" in result.stderr, f"bad Newton override: {result.stderr[-500:]}")
 
-print(f"{len(failures)} failure(s)")
-sys.exit(1 if failures else 0)
+finish()
