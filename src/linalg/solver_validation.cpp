@@ -149,6 +149,24 @@ const Teuchos::ParameterList& ifpack2_names() {
   }();
   return valid;
 }
+
+// Ifpack2 and MueLu bound none of the counts that set the work of one preconditioner set-up or
+// application: 2^31 sweeps or levels keep one Newton step busy for hours, deaf to a stop signal
+// (found by fuzzing). These caps are far above any useful value.
+void check_work_counts(const Teuchos::ParameterList& given, const std::string& origin, const std::string& path) {
+  static const std::pair<const char*, int> caps[] = {
+      {"relaxation: sweeps", 1000},      {"smoother: sweeps", 1000},
+      {"chebyshev: degree", 1000},       {"chebyshev: eigenvalue max iterations", 1000},
+      {"sa: eigenvalue estimate num iterations", 1000},
+      {"fact: iluk level-of-fill", 100}, {"schwarz: overlap level", 100},
+      {"max levels", 31},  // each level halves the grid; no grid has 2^31 cells across
+  };
+  for (const auto& [name, cap] : caps)
+    if (given.isType<int>(name) && given.get<int>(name) > cap)
+      fail(origin, joined(path, name),
+           "value " + std::to_string(given.get<int>(name)) + " is more than " + std::to_string(cap) +
+               ", more work per preconditioner set-up or application than can be useful");
+}
 }  // namespace
 
 void validate_krylov_parameters(const Teuchos::ParameterList& given, const Teuchos::ParameterList& valid,
@@ -176,6 +194,7 @@ void validate_ifpack2_parameters(const std::string& type, const Teuchos::Paramet
              hint(type, {"RELAXATION", "CHEBYSHEV", "BLOCK_RELAXATION", "ILUT", "RILUK", "SCHWARZ", "DIAGONAL"}));
   check_finite(given, origin, path);
   check_against(given, ifpack2_names(), origin, path);
+  check_work_counts(given, origin, path);
   // The preconditioner of that type, without a matrix, checks the values itself: its list of
   // valid parameters with validators where it has one, and setParameters.
   Teuchos::RCP<Ifpack2::Preconditioner<scalar_type, local_ordinal_type, global_ordinal_type, node_type>> prec;
@@ -233,6 +252,11 @@ void validate_muelu_parameters(const Teuchos::ParameterList& given, const std::s
                hint(type, {"RELAXATION", "CHEBYSHEV", "BLOCK RELAXATION", "ILUT", "RILUK", "SCHWARZ", "KLU2"}));
     }
   }
+
+  check_work_counts(given, origin, path);
+  for (const auto& level : levels) check_work_counts(given.sublist(level), origin, joined(path, level));
+  if (given.isType<int>("max levels") && given.get<int>("max levels") < 1)
+    fail(origin, joined(path, "max levels"), "value " + std::to_string(given.get<int>("max levels")) + " is out of range [1, 31]");
 
   // MueLu's interpreter checks the values it knows (algorithms, aggregation and reuse types, ...).
   Teuchos::ParameterList copy = given;

@@ -382,6 +382,10 @@ TEST(SolverConfiguration, ValidatesMueLuAndIfpack2NamesTypesAndValues) {
   m = solver_error("MueLu", parameter("max levels", "string", "ten"));
   expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/max levels");
   EXPECT_NE(m.find("expected int, got string"), std::string::npos) << m;
+  // 2^31 levels: MueLu's interpreter would loop over them for minutes (found by fuzzing).
+  m = solver_error("MueLu", parameter("max levels", "int", "2147483647"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/max levels");
+  EXPECT_NE(m.find("is more than 31"), std::string::npos) << m;
   m = solver_error("MueLu", parameter("smoother: type", "string", "CHEBYCHEV"));
   expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/smoother: type");
   EXPECT_NE(m.find("did you mean 'CHEBYSHEV'"), std::string::npos) << m;
