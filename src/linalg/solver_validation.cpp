@@ -167,6 +167,17 @@ void check_work_counts(const Teuchos::ParameterList& given, const std::string& o
            "value " + std::to_string(given.get<int>(name)) + " is more than " + std::to_string(cap) +
                ", more work per preconditioner set-up or application than can be useful");
 }
+
+// A string parameter that must be one of `words`, when the library checks it too late.
+void check_word(const Teuchos::ParameterList& given, const std::string& name, const std::vector<std::string>& words,
+                const std::string& origin, const std::string& path) {
+  if (!given.isType<std::string>(name)) return;
+  const std::string value = given.get<std::string>(name);
+  if (std::find(words.begin(), words.end(), value) != words.end()) return;
+  std::string list;
+  for (const auto& word : words) list += (list.empty() ? "'" : ", '") + word + "'";
+  fail(origin, joined(path, name), "'" + value + "' is not one of " + list + hint(value, words));
+}
 }  // namespace
 
 void validate_krylov_parameters(const Teuchos::ParameterList& given, const Teuchos::ParameterList& valid,
@@ -197,6 +208,8 @@ void validate_ifpack2_parameters(const std::string& type, const Teuchos::Paramet
   check_work_counts(given, origin, path);
   // The preconditioner of that type, without a matrix, checks the values itself: its list of
   // valid parameters with validators where it has one, and setParameters.
+  // Words Ifpack2 13.2 checks only once it has a matrix (BlockRelaxation::initialize).
+  check_word(given, "partitioner: type", {"linear", "line", "user"}, origin, path);
   Teuchos::RCP<Ifpack2::Preconditioner<scalar_type, local_ordinal_type, global_ordinal_type, node_type>> prec;
   try {
     prec = Ifpack2::Factory::create<row_matrix_type>(type, Teuchos::null);
@@ -254,6 +267,8 @@ void validate_muelu_parameters(const Teuchos::ParameterList& given, const std::s
   }
 
   check_work_counts(given, origin, path);
+  // Checked by MueLu only when the hierarchy is set up (MueLu::toVerbLevel).
+  check_word(given, "verbosity", {"none", "low", "medium", "high", "extreme", "test"}, origin, path);
   for (const auto& level : levels) check_work_counts(given.sublist(level), origin, joined(path, level));
   if (given.isType<int>("max levels") && given.get<int>("max levels") < 1)
     fail(origin, joined(path, "max levels"), "value " + std::to_string(given.get<int>("max levels")) + " is out of range [1, 31]");

@@ -386,6 +386,13 @@ TEST(SolverConfiguration, ValidatesMueLuAndIfpack2NamesTypesAndValues) {
   m = solver_error("MueLu", parameter("max levels", "int", "2147483647"));
   expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/max levels");
   EXPECT_NE(m.find("is more than 31"), std::string::npos) << m;
+  // Words MueLu and Ifpack2 check only once they have a matrix (found by fuzzing).
+  m = solver_error("MueLu", parameter("verbosity", "string", "3"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/verbosity");
+  m = solver_error("Ifpack2", parameter("partitioner: type", "string", "linaer"),
+                   parameter("Ifpack2 type", "string", "BLOCK_RELAXATION"));
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/partitioner: type");
+  EXPECT_NE(m.find("did you mean 'linear'"), std::string::npos) << m;
   m = solver_error("MueLu", parameter("smoother: type", "string", "CHEBYCHEV"));
   expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/smoother: type");
   EXPECT_NE(m.find("did you mean 'CHEBYSHEV'"), std::string::npos) << m;
