@@ -120,6 +120,12 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
       report.failure = "no convergence in " + std::to_string(settings_.max_iterations) + " iterations";
       break;
     }
+    // A stop request on any rank abandons the solve (one agreement per iteration).
+    if (interrupt_ && comm_.any(interrupt_())) {
+      report.interrupted = true;
+      report.failure = "interrupted by a stop request";
+      break;
+    }
     ++report.iterations;
 
     // Direction H dv = −∇E, then the line search along it (both inside: a failed line search

@@ -271,7 +271,7 @@ bool Simulation::advance_to(double t_end, RunSummary& summary, std::ostream* log
     const double remaining = t_end - time_;
     if (dt >= remaining * (1.0 - landing_tolerance)) dt = remaining;
     else if (dt > sliver_fraction * remaining) dt = sliver_fraction * remaining;
-    take_step(dt, summary, log);
+    take_step(dt, summary, log);  // abandoned (time and step unchanged) on a stop request
     if (in_run_ && stop_requested(summary, log)) return false;
   }
   time_ = t_end;
@@ -301,6 +301,10 @@ void Simulation::take_step(double dt, RunSummary& summary, std::ostream* log) {
     summary.preconditioner_setups += newton.preconditioner_setups;
     summary.line_search_seconds += newton.line_search_seconds;
     summary.graph_builds += report.partition_rebuilt;
+    if (newton.interrupted) {  // a stop request: the state stays that of the step's start
+      particles_ = before_step_;
+      return;
+    }
     std::string failure;
     if (!newton.converged) {
       failure = "Newton failed (" + newton.failure + ")";
@@ -448,10 +452,15 @@ RunSummary Simulation::run(std::ostream& log) {
   const auto start = std::chrono::steady_clock::now();
   last_checkpoint_time_ = start;
   in_run_ = true;
+  integrator_->set_interrupt([] { return stop_signal() != 0; });  // a stop request abandons the step
   struct Leave {  // advance_to outside run() ignores stop requests again, however run() ends
+    TimeIntegrator& integrator;
     bool& flag;
-    ~Leave() { flag = false; }
-  } leave{in_run_};
+    ~Leave() {
+      flag = false;
+      integrator.set_interrupt({});
+    }
+  } leave{*integrator_, in_run_};
   if (restarted_) {
     if (comm_.is_root()) frames_ = existing_frames(directory, frame_);  // for the XDMF index
   } else {

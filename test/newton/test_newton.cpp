@@ -44,6 +44,31 @@ TEST(Newton, ConvergesQuadraticallyNearTheSolution) {
   EXPECT_EQ(report.backtracks, 0);
 }
 
+TEST(Newton, AStopRequestOnOneRankEndsTheSolveOnEveryRankAfterTheIterationsBeforeIt) {
+  // The case above needs several iterations; the last rank asks to stop before the third.
+  auto scene = testkit::base_scene(Vec3(1.0, 1.0, 1.0), 0.1);
+  scene.materials.push_back(testkit::oldroyd_b_material("rubber", 1.0, 20.0, 50.0, 0.0, "physical", 1e6));
+  auto body = testkit::box_body("rubber", Vec3(0.3, 0.3, 0.3), Vec3(0.7, 0.7, 0.7), Vec3::Zero());
+  body.angular_velocity = Vec3(0.0, 0.0, 6.0);
+  scene.bodies.push_back(body);
+  scene.newton.tolerance = 1e-13;
+  const parallel::Communicator comm(MPI_COMM_WORLD);
+  simulation::Simulation sim(scene, testkit::jacobi_cg(1e-13), comm);
+  auto& integrator = sim.integrator();
+  integrator.prepare(sim.particles(), 0.02);
+  const auto objective = integrator.build_objective(sim.particles(), 0.0, 0.02);
+  NodeVectorField v = objective->initial_guess;
+  newton::NewtonSolver solver(scene.newton, integrator.newton_system(), comm);
+  int asked = 0;
+  solver.set_interrupt([&] { return ++asked == 3 && comm.rank() == comm.size() - 1; });
+  const auto report = solver.solve(*objective->potential, v);
+  EXPECT_TRUE(report.interrupted);
+  EXPECT_FALSE(report.converged);
+  EXPECT_EQ(report.iterations, 2);
+  EXPECT_EQ(report.residual_history.size(), 3u);
+  EXPECT_EQ(asked, 3);
+}
+
 TEST(Newton, FreeFallMatchesTheExactMotion) {
   const Vec3 g(0.0, -9.81, 0.0), v0(0.5, 1.0, -0.25), lower(0.8, 1.6, 0.8);
   auto scene = testkit::base_scene(Vec3(2.0, 2.4, 2.0), 0.1);

@@ -31,6 +31,7 @@ struct NewtonReport {
   double gradient_seconds = 0.0;               ///< ∇E evaluations
   double line_search_seconds = 0.0;
   std::string failure;                         ///< why it did not converge
+  bool interrupted = false;                    ///< abandoned on a stop request (set_interrupt)
 
   /// One line: residuals and step lengths per iteration (for failure messages).
   std::string history() const;
@@ -56,6 +57,9 @@ class NewtonSolver {
   /// Forgets the Hessian and preconditioner kept from earlier solves (after a failed step, at a
   /// checkpoint), so that the next solve starts as a fresh run would.
   void forget();
+  /// A request to abandon the solve (e.g. a stop signal on this rank), asked before every
+  /// iteration's direction; the ranks agree, so one rank's request ends every rank's solve.
+  void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
   const NewtonSettings& settings() const { return settings_; }
 
  private:
@@ -68,6 +72,7 @@ class NewtonSolver {
   NewtonSettings settings_;
   linalg::NewtonSystem& system_;
   parallel::Communicator comm_;
+  std::function<bool()> interrupt_;
   // What is kept from earlier iterations and solves.
   bool hessian_kept_ = false;           // the system holds an H assembled earlier
   bool kept_projected_ = false;

@@ -1,8 +1,9 @@
 // Requests to stop a run early, as batch systems send them: SIGTERM (the job's time is up, or it
 // is pre-empted), SIGINT (Ctrl-C) and SIGUSR1 (which Open MPI's mpirun forwards to the ranks
 // without ending the job itself). The handler only records the signal; Simulation::run looks at
-// it after every step, agrees on it across ranks (a signal may reach only some of them), writes a
-// checkpoint and returns. A second signal ends the process at once.
+// it before every Newton iteration (abandoning the step) and after every step, agrees on it
+// across ranks (a signal may reach only some of them), writes a checkpoint and returns. A second
+// signal ends the process at once.
 #pragma once
 
 namespace viscompm::simulation {

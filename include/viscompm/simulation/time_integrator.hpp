@@ -104,6 +104,8 @@ class TimeIntegrator {
   void set_decomposition(const parallel::Decomposition& decomposition) { decomposition_ = &decomposition; }
   const grid::GridLayout& layout() const { return layout_; }
   linalg::NewtonSystem& newton_system() { return system_; }
+  /// Newton's solve ends early (the step is not taken) when `requested` is true on any rank.
+  void set_interrupt(std::function<bool()> requested) { newton_.set_interrupt(std::move(requested)); }
   linalg::NodeSpace& node_space() { return space_; }
   /// How many times the node partition has been built.
   int partition_builds() const { return partition_builds_; }
