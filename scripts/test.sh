@@ -7,7 +7,7 @@
 #                                       UndefinedBehaviorSanitizer, leaks checked, the known leaks
 #                                       of MPI and Trilinos suppressed (scripts/sanitizers/)
 #   scripts/test.sh --no-trilinos       only the tests of the physics layer (label no_trilinos),
-#                                       building only them: with --sanitize, what .ci/run adds
+#                                       building only them (with --sanitize: 10 min from cold)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ctest_args=()
