@@ -1,11 +1,13 @@
 // Newton on the incremental potential: quadratic convergence near the solution on a smooth
 // elastic case, free fall under gravity against the exact discrete and continuous motion, and
 // every Newton strategy (Hessian and preconditioner reuse, inexact Newton) reaching the state of
-// exact Newton to the Newton tolerance while doing less work.
+// exact Newton to the Newton tolerance while doing less work; a stop request on one rank ending
+// the solve on every rank.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
+#include <memory>
 
 #include "gather.hpp"
 #include "scenes.hpp"
@@ -13,22 +15,37 @@
 
 using namespace viscompm;
 
-TEST(Newton, ConvergesQuadraticallyNearTheSolution) {
-  // A soft elastic block spinning and stretching: a nonlinear step at a large Δt.
-  auto scene = testkit::base_scene(Vec3(1.0, 1.0, 1.0), 0.1);
-  scene.materials.push_back(testkit::oldroyd_b_material("rubber", 1.0, 20.0, 50.0, 0.0, "physical", 1e6));
-  auto body = testkit::box_body("rubber", Vec3(0.3, 0.3, 0.3), Vec3(0.7, 0.7, 0.7), Vec3::Zero());
-  body.angular_velocity = Vec3(0.0, 0.0, 6.0);
-  scene.bodies.push_back(body);
-  scene.newton.tolerance = 1e-13;
-  scene.newton.max_iterations = 40;
-  const parallel::Communicator comm(MPI_COMM_WORLD);
-  simulation::Simulation sim(scene, testkit::jacobi_cg(1e-13), comm);
-  auto& integrator = sim.integrator();
-  integrator.prepare(sim.particles(), 0.02);
-  const auto objective = integrator.build_objective(sim.particles(), 0.0, 0.02);
-  NodeVectorField v = objective->initial_guess;
-  newton::NewtonSolver solver(scene.newton, integrator.newton_system(), comm);
+namespace {
+// A soft elastic block spinning and stretching: a nonlinear step at a large Δt, ready for Newton.
+class NewtonOnASpinningBlock : public ::testing::Test {
+ protected:
+  static scene::SceneConfig spinning_block() {
+    auto scene = testkit::base_scene(Vec3(1.0, 1.0, 1.0), 0.1);
+    scene.materials.push_back(testkit::oldroyd_b_material("rubber", 1.0, 20.0, 50.0, 0.0, "physical", 1e6));
+    auto body = testkit::box_body("rubber", Vec3(0.3, 0.3, 0.3), Vec3(0.7, 0.7, 0.7), Vec3::Zero());
+    body.angular_velocity = Vec3(0.0, 0.0, 6.0);
+    scene.bodies.push_back(body);
+    scene.newton.tolerance = 1e-13;
+    scene.newton.max_iterations = 40;
+    return scene;
+  }
+  NewtonOnASpinningBlock()
+      : comm(MPI_COMM_WORLD), scene(spinning_block()), sim(scene, testkit::jacobi_cg(1e-13), comm) {
+    sim.integrator().prepare(sim.particles(), dt);
+    objective = sim.integrator().build_objective(sim.particles(), 0.0, dt);
+    v = objective->initial_guess;
+  }
+  static constexpr double dt = 0.02;
+  const parallel::Communicator comm;
+  const scene::SceneConfig scene;
+  simulation::Simulation sim;
+  std::unique_ptr<simulation::StepObjective> objective;
+  NodeVectorField v;
+};
+}  // namespace
+
+TEST_F(NewtonOnASpinningBlock, ConvergesQuadraticallyNearTheSolution) {
+  newton::NewtonSolver solver(scene.newton, sim.integrator().newton_system(), comm);
   const auto report = solver.solve(*objective->potential, v);
   ASSERT_TRUE(report.converged) << report.failure;
   const auto& r = report.residual_history;
@@ -44,21 +61,9 @@ TEST(Newton, ConvergesQuadraticallyNearTheSolution) {
   EXPECT_EQ(report.backtracks, 0);
 }
 
-TEST(Newton, AStopRequestOnOneRankEndsTheSolveOnEveryRankAfterTheIterationsBeforeIt) {
-  // The case above needs several iterations; the last rank asks to stop before the third.
-  auto scene = testkit::base_scene(Vec3(1.0, 1.0, 1.0), 0.1);
-  scene.materials.push_back(testkit::oldroyd_b_material("rubber", 1.0, 20.0, 50.0, 0.0, "physical", 1e6));
-  auto body = testkit::box_body("rubber", Vec3(0.3, 0.3, 0.3), Vec3(0.7, 0.7, 0.7), Vec3::Zero());
-  body.angular_velocity = Vec3(0.0, 0.0, 6.0);
-  scene.bodies.push_back(body);
-  scene.newton.tolerance = 1e-13;
-  const parallel::Communicator comm(MPI_COMM_WORLD);
-  simulation::Simulation sim(scene, testkit::jacobi_cg(1e-13), comm);
-  auto& integrator = sim.integrator();
-  integrator.prepare(sim.particles(), 0.02);
-  const auto objective = integrator.build_objective(sim.particles(), 0.0, 0.02);
-  NodeVectorField v = objective->initial_guess;
-  newton::NewtonSolver solver(scene.newton, integrator.newton_system(), comm);
+TEST_F(NewtonOnASpinningBlock, AStopRequestOnOneRankEndsTheSolveOnEveryRankAfterTheIterationsBeforeIt) {
+  // The last rank asks to stop before the third iteration.
+  newton::NewtonSolver solver(scene.newton, sim.integrator().newton_system(), comm);
   int asked = 0;
   solver.set_interrupt([&] { return ++asked == 3 && comm.rank() == comm.size() - 1; });
   const auto report = solver.solve(*objective->potential, v);
