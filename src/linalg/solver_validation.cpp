@@ -206,10 +206,10 @@ void validate_ifpack2_parameters(const std::string& type, const Teuchos::Paramet
   check_finite(given, origin, path);
   check_against(given, ifpack2_names(), origin, path);
   check_work_counts(given, origin, path);
-  // The preconditioner of that type, without a matrix, checks the values itself: its list of
-  // valid parameters with validators where it has one, and setParameters.
   // Words Ifpack2 13.2 checks only once it has a matrix (BlockRelaxation::initialize).
   check_word(given, "partitioner: type", {"linear", "line", "user"}, origin, path);
+  // The preconditioner of that type, without a matrix, checks the values itself: its list of
+  // valid parameters with validators where it has one, and setParameters.
   Teuchos::RCP<Ifpack2::Preconditioner<scalar_type, local_ordinal_type, global_ordinal_type, node_type>> prec;
   try {
     prec = Ifpack2::Factory::create<row_matrix_type>(type, Teuchos::null);
