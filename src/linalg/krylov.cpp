@@ -1,4 +1,5 @@
 #include "krylov.hpp"
+#include "preconditioner.hpp"
 
 #include <BelosSolverFactory.hpp>
 #include <chrono>

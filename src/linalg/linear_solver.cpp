@@ -7,7 +7,7 @@
 #include "solver_configuration_impl.hpp"
 #include "solver_validation.hpp"
 #include "viscompm/core/error.hpp"
-#include "viscompm/linalg/linalg_types.hpp"
+#include "linalg_types.hpp"
 #include "viscompm/params/parameter_io.hpp"
 
 namespace viscompm::linalg {
@@ -17,22 +17,41 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
     ParameterTable<SolverSettings> table;
     using S = SolverSettings;
     table.string(&S::label, "Label", "", {}, "name of this configuration in solver.csv and study.csv")
-        .string(&S::operator_form, "Operator", "assembled", {"assembled", "matrix-free"},
+        .choice(&S::operator_form, "Operator", OperatorForm::assembled,
+                {{"assembled", OperatorForm::assembled}, {"matrix-free", OperatorForm::matrix_free}},
                 "assembled Tpetra matrix, or the paper's matrix-free Hessian-vector product (§5.7)")
         .string(&S::krylov_solver, "Krylov solver", "Pseudo Block CG", {"Pseudo Block CG", "Block CG"},
                 "Belos solver (Pseudo Block CG is Belos' CG)")
-        .string(&S::preconditioner, "Preconditioner", "Ifpack2", {"none", "Jacobi", "Ifpack2", "MueLu"},
+        .choice(&S::preconditioner, "Preconditioner", PreconditionerKind::ifpack2,
+                {{"none", PreconditionerKind::none}, {"Jacobi", PreconditionerKind::jacobi},
+                 {"Ifpack2", PreconditionerKind::ifpack2}, {"MueLu", PreconditionerKind::muelu}},
                 "none; Jacobi (exact diagonal of H, also matrix-free); Ifpack2 or MueLu (assembled only)")
         .string(&S::ifpack2_type, "Ifpack2 type", "RELAXATION", {}, "Ifpack2::Factory name (RELAXATION, CHEBYSHEV, ...)")
-        .string(&S::prolongation, "Prolongation", "algebraic", {"algebraic", "trilinear", "quadratic B-spline", "piecewise constant"},
+        .choice(&S::prolongation, "Prolongation", Prolongation::algebraic,
+                {{"algebraic", Prolongation::algebraic}, {"trilinear", Prolongation::trilinear},
+                 {"quadratic B-spline", Prolongation::quadratic_bspline},
+                 {"piecewise constant", Prolongation::piecewise_constant}},
                 "MueLu: the prolongators of its own aggregation (algebraic), or geometric ones between the grids "
                 "Δx, 2Δx, 4Δx, ... (trilinear, the coarse quadratic B-spline at the fine nodes, or piecewise "
                 "constant: 2×2×2-node aggregates, unsmoothed)")
         .integer(&S::coarsest_nodes, "Coarsest nodes", 2000, Range::at_least(1),
                  "geometric prolongation: coarsen until a level has at most this many nodes")
-        .string(&S::near_nullspace, "Near nullspace", "rigid body modes", {"rigid body modes", "translations"},
+        .choice(&S::near_nullspace, "Near nullspace", NearNullspaceModes::rigid_body_modes,
+                {{"rigid body modes", NearNullspaceModes::rigid_body_modes},
+                 {"translations", NearNullspaceModes::translations}},
                 "algebraic MueLu: the modes its aggregates must represent (the 6 rigid-body modes, or the 3 "
-                "translations, for aggregates of a node or two)");
+                "translations, for aggregates of a node or two)")
+        .choice(&S::smoother_blocks, "Smoother blocks", SmootherBlocks::library,
+                {{"library", SmootherBlocks::library}, {"grid lines", SmootherBlocks::grid_lines}},
+                "library: smoothers as the Preconditioner parameters say; grid lines: the fine level's "
+                "BLOCK_RELAXATION smoother (Ifpack2, or MueLu's \"level 0\") gets its blocks from viscompm — the "
+                "runs of grid nodes along each axis, overlapping (one per axis), which solve the strong coupling "
+                "across thin stiff parts — and its damping (Line damping / λmax)")
+        .integer(&S::line_length, "Line length", 16, Range::closed(1, 4096),
+                 "grid lines: the most nodes in one block (longer runs are cut into near-equal pieces)")
+        .real(&S::line_damping, "Line damping", 1.5, Range::open_closed(0.0, 2.0),
+              "grid lines: the block Jacobi damping is this over the largest eigenvalue of (blocks⁻¹ H), "
+              "estimated by power iterations at each set-up (< 2 for a convergent smoother)");
     return table;
   }();
   return t;
@@ -41,6 +60,48 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
 namespace {
 constexpr const char* krylov_sublist = "Krylov parameters";
 constexpr const char* preconditioner_sublist = "Preconditioner parameters";
+
+bool is_block_relaxation(const std::string& type) {
+  return type == "BLOCK_RELAXATION" || type == "BLOCK RELAXATION" || type == "BLOCKRELAXATION";
+}
+
+// Smoother blocks = grid lines: the fine level's smoother must be a block relaxation whose blocks
+// viscompm can give (partitioner "user"); viscompm sets the blocks and the damping itself.
+void validate_grid_line_smoother(const SolverConfiguration::Impl& impl, const std::string& origin) {
+  const SolverSettings& s = impl.settings;
+  const Teuchos::ParameterList* smoother = nullptr;
+  std::string where;
+  if (s.preconditioner == PreconditionerKind::ifpack2 && is_block_relaxation(s.ifpack2_type)) {
+    smoother = impl.preconditioner_parameters.get();
+    where = preconditioner_sublist;
+  } else if (s.preconditioner == PreconditionerKind::muelu && impl.preconditioner_parameters->isSublist("level 0")) {
+    const Teuchos::ParameterList& level0 = impl.preconditioner_parameters->sublist("level 0");
+    if (level0.isType<std::string>("smoother: type") && is_block_relaxation(level0.get<std::string>("smoother: type")) &&
+        level0.isSublist("smoother: params")) {
+      smoother = &level0.sublist("smoother: params");
+      where = std::string(preconditioner_sublist) + "/level 0/smoother: params";
+    }
+  }
+  if (smoother == nullptr)
+    throw InputError(origin + ": parameter 'Smoother blocks': grid lines need a BLOCK_RELAXATION smoother on the fine "
+                     "level: Ifpack2 type BLOCK_RELAXATION, or MueLu's \"level 0\" list with smoother: type BLOCK "
+                     "RELAXATION and its smoother: params");
+  for (const char* name : {"partitioner: local parts", "partitioner: map", "partitioner: parts",
+                           "relaxation: damping factor"})
+    if (smoother->isParameter(name))
+      throw InputError(origin + ": parameter '" + where + "/" + name +
+                       "': set by viscompm when Smoother blocks = grid lines");
+  auto word = [smoother](const char* name, const char* otherwise) {
+    return smoother->isType<std::string>(name) ? smoother->get<std::string>(name) : std::string(otherwise);
+  };
+  if (word("partitioner: type", "") != "user")
+    throw InputError(origin + ": parameter '" + where + "/partitioner: type': must be 'user' when Smoother blocks = grid lines");
+  const std::string relaxation = word("relaxation: type", "Jacobi");
+  if (relaxation != "Jacobi" && relaxation != "Symmetric Gauss-Seidel")
+    throw InputError(origin + ": parameter '" + where + "/relaxation: type': must be 'Jacobi' or 'Symmetric "
+                     "Gauss-Seidel' when Smoother blocks = grid lines (the blocks overlap: their additive or symmetric "
+                     "multiplicative combination is symmetric)");
+}
 
 std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& list, const std::string& origin) {
   auto impl = std::make_shared<SolverConfiguration::Impl>();
@@ -61,21 +122,26 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   auto solver = factory.create(s.krylov_solver, Teuchos::null);
   validate_krylov_parameters(*impl->krylov_parameters, *solver->getValidParameters(), origin, krylov_sublist);
 
-  if (s.operator_form == "matrix-free" && (s.preconditioner == "Ifpack2" || s.preconditioner == "MueLu"))
-    throw InputError(origin + ": parameter 'Preconditioner': " + s.preconditioner +
+  const std::string preconditioner_word = values.string("Preconditioner");
+  const bool library_preconditioner =
+      s.preconditioner == PreconditionerKind::ifpack2 || s.preconditioner == PreconditionerKind::muelu;
+  if (s.operator_form == OperatorForm::matrix_free && library_preconditioner)
+    throw InputError(origin + ": parameter 'Preconditioner': " + preconditioner_word +
                      " needs the assembled matrix (Operator = assembled)");
-  if (s.preconditioner == "Ifpack2")
+  if (s.preconditioner == PreconditionerKind::ifpack2)
     validate_ifpack2_parameters(s.ifpack2_type, *impl->preconditioner_parameters, origin, "Ifpack2 type",
                                 preconditioner_sublist);
-  if (s.preconditioner == "MueLu") validate_muelu_parameters(*impl->preconditioner_parameters, origin, preconditioner_sublist);
-  if ((s.preconditioner == "none" || s.preconditioner == "Jacobi") && impl->preconditioner_parameters->numParams() > 0)
-    throw InputError(origin + ": parameter '" + preconditioner_sublist + "': " + s.preconditioner +
+  if (s.preconditioner == PreconditionerKind::muelu)
+    validate_muelu_parameters(*impl->preconditioner_parameters, origin, preconditioner_sublist);
+  if (!library_preconditioner && impl->preconditioner_parameters->numParams() > 0)
+    throw InputError(origin + ": parameter '" + preconditioner_sublist + "': " + preconditioner_word +
                      " takes no parameters");
-  if (s.prolongation != "algebraic" && s.preconditioner != "MueLu")
+  if (s.prolongation != Prolongation::algebraic && s.preconditioner != PreconditionerKind::muelu)
     throw InputError(origin + ": parameter 'Prolongation': geometric prolongators are for Preconditioner = MueLu");
+  if (s.smoother_blocks == SmootherBlocks::grid_lines) validate_grid_line_smoother(*impl, origin);
   if (s.label.empty()) {
-    s.label = (s.operator_form == "matrix-free" ? "matrix-free " : "") +
-              (s.preconditioner == "Ifpack2" ? "Ifpack2 " + s.ifpack2_type : s.preconditioner);
+    s.label = (s.operator_form == OperatorForm::matrix_free ? "matrix-free " : "") +
+              (s.preconditioner == PreconditionerKind::ifpack2 ? "Ifpack2 " + s.ifpack2_type : preconditioner_word);
     if (impl->preconditioner_parameters->isParameter("relaxation: type"))
       s.label += " " + impl->preconditioner_parameters->get<std::string>("relaxation: type");
   }
@@ -103,6 +169,6 @@ SolverConfiguration SolverConfiguration::from_xml(const std::string& xml, const 
 
 const std::string& SolverConfiguration::label() const { return impl_->settings.label; }
 const std::string& SolverConfiguration::origin() const { return impl_->origin; }
-bool SolverConfiguration::matrix_free() const { return impl_->settings.operator_form == "matrix-free"; }
+bool SolverConfiguration::matrix_free() const { return impl_->settings.operator_form == OperatorForm::matrix_free; }
 
 }  // namespace viscompm::linalg

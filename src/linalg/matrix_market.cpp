@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "krylov.hpp"
+#include "preconditioner.hpp"
 #include "matrix_market_io.hpp"
 #include "viscompm/core/error.hpp"
 #include "viscompm/parallel/decomposition.hpp"
@@ -197,7 +198,7 @@ std::int64_t MatrixMarketProblem::nonzeros() const {
 bool MatrixMarketProblem::has_coordinates() const { return !impl_->modes.coordinates.is_null(); }
 
 MatrixMarketSolve MatrixMarketProblem::solve(const SolverConfiguration& config) const {
-  if (config.impl().settings.operator_form == "matrix-free")
+  if (config.impl().settings.operator_form == OperatorForm::matrix_free)
     throw InputError(config.origin() + ": a matrix-free configuration cannot solve a MatrixMarket system");
   const auto& A = impl_->A;
   multivector_type x(A->getDomainMap(), 1), b(*impl_->b, Teuchos::Copy);
@@ -213,6 +214,12 @@ MatrixMarketSolve MatrixMarketProblem::solve(const SolverConfiguration& config) 
   const auto apply_start = std::chrono::steady_clock::now();
   for (int k = 0; k < 5; ++k) A->apply(x, b);
   result.apply_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - apply_start).count() / 5;
+  if (const auto M = preconditioner->op(); !M.is_null()) {
+    const auto preconditioner_start = std::chrono::steady_clock::now();
+    for (int k = 0; k < 5; ++k) M->apply(b, x);
+    result.preconditioner_apply_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - preconditioner_start).count() / 5;
+  }
   return result;
 }
 

@@ -1,7 +1,7 @@
 // MatrixMarket files of Newton systems (private to src/linalg).
 #pragma once
 
-#include "viscompm/linalg/linalg_types.hpp"
+#include "linalg_types.hpp"
 
 namespace viscompm::linalg {
 

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "krylov.hpp"
+#include "preconditioner.hpp"
 #include "hessian_operator.hpp"
 #include "matrix_market_io.hpp"
 
@@ -14,7 +15,7 @@ struct NewtonSystem::Impl {
   Impl(const NodeSpace& s, const SolverConfiguration& c)
       : space(s),
         config(c),
-        hessian(c.impl().settings.operator_form == "matrix-free" ? make_matrix_free_hessian(s) : make_assembled_hessian(s)),
+        hessian(c.impl().settings.operator_form == OperatorForm::matrix_free ? make_matrix_free_hessian(s) : make_assembled_hessian(s)),
         preconditioner(make_preconditioner(c)),
         krylov(c) {}
 
@@ -149,6 +150,19 @@ LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorFiel
   m.from_owned(x, dv);
   return report;
 }
+
+void NewtonSystem::apply_preconditioner(const NodeVectorField& r, NodeVectorField& z) {
+  Impl& m = *impl_;
+  if (!m.preconditioned) precondition();
+  multivector_type R(m.space.impl().owned_dof_map, 1), Z(m.space.impl().owned_dof_map, 1);
+  m.to_owned(r, R);
+  const auto op = m.preconditioner->op();
+  if (op.is_null()) Z.assign(R);
+  else op->apply(R, Z);
+  m.from_owned(Z, z);
+}
+
+bool NewtonSystem::has_preconditioner() const { return impl_->config.impl().settings.preconditioner != PreconditionerKind::none; }
 
 void NewtonSystem::apply(const NodeVectorField& x, NodeVectorField& y) const {
   const Impl& m = *impl_;

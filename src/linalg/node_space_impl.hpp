@@ -1,7 +1,7 @@
 // Tpetra side of NodeSpace, shared by the linear-algebra translation units.
 #pragma once
 
-#include "viscompm/linalg/linalg_types.hpp"
+#include "linalg_types.hpp"
 #include "viscompm/linalg/node_space.hpp"
 
 namespace viscompm::linalg {

@@ -5,9 +5,18 @@
 #include <Ifpack2_Factory.hpp>
 #include <MueLu_CreateTpetraPreconditioner.hpp>
 #include <MueLu_HierarchyUtils.hpp>
+#include <MueLu_Ifpack2Smoother.hpp>
+#include <MueLu_TrilinosSmoother.hpp>
 #include <MueLu_ParameterListInterpreter.hpp>
 
-#include "krylov.hpp"
+#include "preconditioner.hpp"
+
+#include <Ifpack2_BlockRelaxation.hpp>
+#include <iostream>
+#include <streambuf>
+#include <Teuchos_ScalarTraits.hpp>
+
+#include "viscompm/grid/node_lines.hpp"
 #include "viscompm/core/error.hpp"
 #include "viscompm/parallel/grid_hierarchy.hpp"
 
@@ -32,6 +41,101 @@ Teuchos::RCP<multivector_type> rigid_body_modes(const multivector_type& coordina
 }
 
 namespace {
+using parts_type = Teuchos::Array<Teuchos::ArrayRCP<local_ordinal_type>>;
+
+// The runs of owned grid nodes along each axis as blocks of dofs (3 per node, consecutive).
+parts_type grid_line_parts(const SystemGrid& grid, int max_nodes) {
+  parts_type parts;
+  for (const auto& line : grid::node_lines(grid.owned_nodes, max_nodes)) {
+    Teuchos::ArrayRCP<local_ordinal_type> dofs(3 * line.size());
+    for (std::size_t k = 0; k < line.size(); ++k)
+      for (int d = 0; d < 3; ++d) dofs[3 * k + d] = static_cast<local_ordinal_type>(3 * line[k] + d);
+    parts.push_back(dofs);
+  }
+  return parts;
+}
+
+// Smoother blocks = grid lines: a block-relaxation smoother's blocks from the grid, and its
+// damping from the matrix it smooths.
+class GridLines {
+ public:
+  /// The runs of owned grid nodes along each axis, as blocks of dofs (3 per node, consecutive).
+  static parts_type parts(const SystemGrid& grid, int max_nodes) {
+    parts_type parts;
+    for (const auto& line : grid::node_lines(grid.owned_nodes, max_nodes)) {
+      Teuchos::ArrayRCP<local_ordinal_type> dofs(3 * line.size());
+      for (std::size_t k = 0; k < line.size(); ++k)
+        for (int d = 0; d < 3; ++d) dofs[3 * k + d] = static_cast<local_ordinal_type>(3 * line[k] + d);
+      parts.push_back(dofs);
+    }
+    return parts;
+  }
+
+  /// Additive (Jacobi) blocks need a damping below 2/λmax(S A), S one undamped sweep of block
+  /// solves: `smoother` (set up on A) gets Line damping / λmax, λmax by power iterations that
+  /// start from the last estimate's vector while the pattern stays (the same start on any rank
+  /// count at first). Gauss-Seidel over the blocks needs none.
+  void set_damping(ifpack2_preconditioner_type& smoother, const crs_matrix_type& A, const SolverSettings& settings,
+                   const Teuchos::ParameterList& configured, bool pattern_changed) {
+    if (configured.isType<std::string>("relaxation: type") && configured.get<std::string>("relaxation: type") != "Jacobi")
+      return;
+    Teuchos::ParameterList one_sweep;
+    one_sweep.set("relaxation: damping factor", 1.0);
+    one_sweep.set("relaxation: sweeps", 1);
+    one_sweep.set("relaxation: zero starting solution", true);
+    smoother.setParameters(one_sweep);
+    int iterations = 5;
+    if (pattern_changed || eigenvector_.is_null()) {
+      eigenvector_ = Teuchos::rcp(new vector_type(A.getDomainMap()));
+      auto view = eigenvector_->getLocalViewHost(Tpetra::Access::OverwriteAll);
+      const auto& map = *A.getDomainMap();
+      for (std::size_t i = 0; i < view.extent(0); ++i)
+        view(i, 0) = 1.0 + 0.5 * std::sin(1.7 * static_cast<double>(map.getGlobalElement(static_cast<local_ordinal_type>(i))));
+      iterations = 12;
+    }
+    vector_type& x = *eigenvector_;
+    vector_type y(A.getRangeMap());
+    double lambda = 0.0;
+    for (int k = 0; k < iterations; ++k) {
+      x.scale(1.0 / x.norm2());
+      A.apply(x, y);
+      smoother.apply(y, x);
+      lambda = x.norm2();
+    }
+    Teuchos::ParameterList configured_sweeps;
+    configured_sweeps.set("relaxation: damping factor", settings.line_damping / lambda);
+    configured_sweeps.set("relaxation: sweeps",
+                          configured.isType<int>("relaxation: sweeps") ? configured.get<int>("relaxation: sweeps") : 1);
+    configured_sweeps.set("relaxation: zero starting solution",
+                          !configured.isType<bool>("relaxation: zero starting solution") ||
+                              configured.get<bool>("relaxation: zero starting solution"));
+    smoother.setParameters(configured_sweeps);
+    damping_ = settings.line_damping / lambda;
+  }
+  double damping() const { return damping_; }
+
+ private:
+  Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate, on the current pattern
+  double damping_ = 0.0;
+};
+
+// MueLu 13.2 prints a block-relaxation smoother's parameter list to std::cout whenever it sets one
+// up (MueLu_Ifpack2Smoother_def.hpp, SetupBlockRelaxation: an unconditional print()); the
+// hierarchy's set-up runs with std::cout silenced (doc/trilinos.md).
+class SilencedStdout {
+ public:
+  SilencedStdout() : saved_(std::cout.rdbuf(&null_)) {}
+  ~SilencedStdout() { std::cout.rdbuf(saved_); }
+  SilencedStdout(const SilencedStdout&) = delete;
+  SilencedStdout& operator=(const SilencedStdout&) = delete;
+
+ private:
+  struct NullBuffer : std::streambuf {
+    int overflow(int c) override { return traits_type::not_eof(c); }
+  } null_;
+  std::streambuf* saved_;
+};
+
 class NoPreconditioner : public Preconditioner {
  public:
   void setup(const HessianOperator&, bool, const NearNullspace&) override {}
@@ -65,30 +169,43 @@ class JacobiPreconditioner : public Preconditioner {
   Teuchos::RCP<operator_type> op_;
 };
 
+// The grid a grid-line smoother needs (a scene's, or a MatrixMarket dump's with coordinates).
+const SystemGrid* grid_of(const NearNullspace& modes) {
+  if (!modes.grid) throw InputError("Smoother blocks = grid lines need the grid of the system (a scene, or a "
+                                    "MatrixMarket dump with node coordinates)");
+  return modes.grid.get();
+}
+
 class Ifpack2Preconditioner : public Preconditioner {
  public:
   explicit Ifpack2Preconditioner(const SolverConfiguration& config) : config_(config) {}
-  void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace&) override {
+  void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace& modes) override {
     const Teuchos::RCP<crs_matrix_type> A = H.matrix();
+    const SolverSettings& settings = config_.impl().settings;
+    const bool grid_lines = settings.smoother_blocks == SmootherBlocks::grid_lines;
     if (pattern_changed || prec_.is_null()) {
-      prec_ = Ifpack2::Factory::create<row_matrix_type>(config_.impl().settings.ifpack2_type, A);
+      prec_ = Ifpack2::Factory::create<row_matrix_type>(settings.ifpack2_type, A);
       if (prec_.is_null())
         throw InputError(config_.origin() + ": parameter 'Ifpack2 type': unknown Ifpack2 preconditioner '" +
-                         config_.impl().settings.ifpack2_type + "'");
+                         settings.ifpack2_type + "'");
       Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
       // 3×3 point-block relaxation: one block per node (a node's three dofs are consecutive).
-      if (config_.impl().settings.ifpack2_type == "BLOCK_RELAXATION" && !params.isParameter("partitioner: local parts"))
+      if (settings.ifpack2_type == "BLOCK_RELAXATION" && !grid_lines && !params.isParameter("partitioner: local parts"))
         params.set("partitioner: local parts", static_cast<local_ordinal_type>(A->getNodeNumRows() / 3));
+      if (grid_lines) params.set("partitioner: parts", GridLines::parts(*grid_of(modes), settings.line_length));
       prec_->setParameters(params);
       prec_->initialize();
     }
     prec_->compute();  // new values, same pattern
+    if (grid_lines)
+      lines_.set_damping(*prec_, *A, settings, *config_.impl().preconditioner_parameters, pattern_changed);
   }
   Teuchos::RCP<operator_type> op() const override { return prec_; }
 
  private:
   SolverConfiguration config_;
   Teuchos::RCP<ifpack2_preconditioner_type> prec_;
+  GridLines lines_;
 };
 
 // P of one coarse level: rows = the finer level's owned dofs, columns = this level's owned and
@@ -141,8 +258,17 @@ class MueLuPreconditioner : public Preconditioner {
     }
     Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
     if (!params.isParameter("number of equations")) params.set("number of equations", 3);
-    if (config_.impl().settings.prolongation == "algebraic") setup_algebraic(A, params, modes);
-    else setup_geometric(A, params, modes);
+    const SolverSettings& settings = config_.impl().settings;
+    const bool grid_lines = settings.smoother_blocks == SmootherBlocks::grid_lines;
+    if (grid_lines)
+      params.sublist("level 0").sublist("smoother: params").set("partitioner: parts",
+                                                                 GridLines::parts(*grid_of(modes), settings.line_length));
+    {
+      const SilencedStdout quiet;
+      if (settings.prolongation == Prolongation::algebraic) setup_algebraic(A, params, modes);
+      else setup_geometric(A, params, modes);
+    }
+    if (grid_lines) set_fine_smoother_damping(*A, pattern_changed);
   }
   Teuchos::RCP<operator_type> op() const override { return prec_; }
   Teuchos::RCP<const crs_matrix_type> level_matrix(int level) const override {
@@ -166,7 +292,7 @@ class MueLuPreconditioner : public Preconditioner {
     Teuchos::ParameterList& user = params.sublist("user data");
     if (!modes.coordinates.is_null()) user.set("Coordinates", modes.coordinates);
     if (!modes.rigid_body_modes.is_null()) {
-      if (config_.impl().settings.near_nullspace == "translations") {
+      if (config_.impl().settings.near_nullspace == NearNullspaceModes::translations) {
         Teuchos::RCP<multivector_type> translations = modes.rigid_body_modes->subCopy(Teuchos::Range1D(0, 2));
         user.set("Nullspace", translations);
       } else {
@@ -191,10 +317,10 @@ class MueLuPreconditioner : public Preconditioner {
     const auto comm = A->getRowMap()->getComm();
     const parallel::Communicator communicator(*Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm)->getRawMpiComm());
     parallel::HierarchySettings settings;
-    const std::string& kind = config_.impl().settings.prolongation;
-    settings.prolongation = kind == "trilinear"            ? parallel::Prolongation::trilinear
-                            : kind == "piecewise constant" ? parallel::Prolongation::piecewise_constant
-                                                           : parallel::Prolongation::quadratic_bspline;
+    const Prolongation kind = config_.impl().settings.prolongation;
+    settings.prolongation = kind == Prolongation::trilinear            ? parallel::Prolongation::trilinear
+                            : kind == Prolongation::piecewise_constant ? parallel::Prolongation::piecewise_constant
+                                                                       : parallel::Prolongation::quadratic_bspline;
     settings.max_levels = params.get<int>("max levels", 10);
     settings.coarsest_nodes = config_.impl().settings.coarsest_nodes;
     const auto levels = parallel::build_grid_hierarchy(communicator, modes.grid->dimensions, modes.grid->owned_nodes,
@@ -219,16 +345,39 @@ class MueLuPreconditioner : public Preconditioner {
     prec_ = Teuchos::rcp(new muelu_operator_type(hierarchy));
   }
 
+  // The fine level's block relaxation (pre- and post-smoother, one object or two) gets its damping.
+  void set_fine_smoother_damping(const crs_matrix_type& A, bool pattern_changed) {
+    const auto level = prec_->GetHierarchy()->GetLevel(0);
+    const Teuchos::ParameterList& configured =
+        config_.impl().preconditioner_parameters->sublist("level 0").sublist("smoother: params");
+    Teuchos::RCP<muelu_ifpack2_smoother_type> previous;
+    for (const char* which : {"PreSmoother", "PostSmoother"}) {
+      if (!level->IsAvailable(which)) continue;
+      // MueLu's interpreter wraps its Ifpack2 smoothers in a TrilinosSmoother.
+      const auto held = level->template Get<Teuchos::RCP<muelu_smoother_type>>(which);
+      auto smoother = Teuchos::rcp_dynamic_cast<muelu_ifpack2_smoother_type>(held);
+      if (const auto wrapper = Teuchos::rcp_dynamic_cast<muelu_trilinos_smoother_type>(held); !wrapper.is_null())
+        smoother = Teuchos::rcp_dynamic_cast<muelu_ifpack2_smoother_type>(wrapper->getSmoother());
+      if (smoother.is_null() || smoother == previous) continue;
+      lines_.set_damping(*smoother->getPreconditioner(), A, config_.impl().settings, configured,
+                         pattern_changed || !previous.is_null());
+      previous = smoother;
+    }
+  }
+
   SolverConfiguration config_;
   Teuchos::RCP<muelu_operator_type> prec_;
+  GridLines lines_;
 };
 }  // namespace
 
 std::unique_ptr<Preconditioner> make_preconditioner(const SolverConfiguration& config) {
-  const std::string& kind = config.impl().settings.preconditioner;
-  if (kind == "Ifpack2") return std::make_unique<Ifpack2Preconditioner>(config);
-  if (kind == "MueLu") return std::make_unique<MueLuPreconditioner>(config);
-  if (kind == "Jacobi") return std::make_unique<JacobiPreconditioner>();
+  switch (config.impl().settings.preconditioner) {
+    case PreconditionerKind::ifpack2: return std::make_unique<Ifpack2Preconditioner>(config);
+    case PreconditionerKind::muelu: return std::make_unique<MueLuPreconditioner>(config);
+    case PreconditionerKind::jacobi: return std::make_unique<JacobiPreconditioner>();
+    case PreconditionerKind::none: break;
+  }
   return std::make_unique<NoPreconditioner>();
 }
 

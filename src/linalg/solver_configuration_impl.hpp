@@ -8,16 +8,28 @@
 
 namespace viscompm::linalg {
 
-/// The top level of a solver file.
+enum class OperatorForm { assembled, matrix_free };
+enum class PreconditionerKind { none, jacobi, ifpack2, muelu };
+/// MueLu's own aggregation, or prolongators between the grids Δx, 2Δx, 4Δx, ...
+enum class Prolongation { algebraic, trilinear, quadratic_bspline, piecewise_constant };
+enum class NearNullspaceModes { rigid_body_modes, translations };
+/// Where the blocks of the fine level's BLOCK_RELAXATION smoother come from.
+enum class SmootherBlocks { library, grid_lines };
+
+/// The top level of a solver file; its words are parsed once, into enums (the Krylov solver and
+/// Ifpack2 type are names the libraries' factories take).
 struct SolverSettings {
   std::string label;
-  std::string operator_form = "assembled";
+  OperatorForm operator_form = OperatorForm::assembled;
   std::string krylov_solver = "Pseudo Block CG";
-  std::string preconditioner = "Ifpack2";
+  PreconditionerKind preconditioner = PreconditionerKind::ifpack2;
   std::string ifpack2_type = "RELAXATION";
-  std::string prolongation = "algebraic";
+  Prolongation prolongation = Prolongation::algebraic;
   int coarsest_nodes = 2000;
-  std::string near_nullspace = "rigid body modes";
+  NearNullspaceModes near_nullspace = NearNullspaceModes::rigid_body_modes;
+  SmootherBlocks smoother_blocks = SmootherBlocks::library;
+  int line_length = 16;
+  double line_damping = 1.5;
 
   static const ParameterTable<SolverSettings>& table();
 };

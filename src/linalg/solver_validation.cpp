@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
-#include "viscompm/linalg/linalg_types.hpp"
+#include "linalg_types.hpp"
 #include "viscompm/params/parameter_io.hpp"
 
 namespace viscompm::linalg {

@@ -6,7 +6,12 @@ const ParameterTable<NewtonSettings>& NewtonSettings::table() {
   static const ParameterTable<NewtonSettings> t = [] {
     ParameterTable<NewtonSettings> table;
     using N = NewtonSettings;
-    table.integer(&N::max_iterations, "Max iterations", 20, Range::at_least(1), "Newton iterations per step before Δt is halved")
+    table.choice(&N::method, "Method", Method::newton, {{"newton", Method::newton}, {"L-BFGS", Method::lbfgs}},
+                 "newton: solve H dv = −∇E with the solver file's Krylov method; L-BFGS: quasi-Newton directions "
+                 "whose initial inverse Hessian is one application of the solver file's preconditioner on the "
+                 "SPD-projected H, built once per step (HOT); same line search and convergence test")
+        .integer(&N::max_iterations, "Max iterations", 20, Range::at_least(1),
+                 "iterations (directions) per step before Δt is halved")
         .real(&N::tolerance, "Tolerance", 1e-6, Range::positive(),
               "converged when the mass-weighted residual velocity is below Tolerance·Δx/Δt")
         .integer(&N::max_line_search_steps, "Max line search steps", 20, Range::at_least(1),
@@ -16,6 +21,10 @@ const ParameterTable<NewtonSettings>& NewtonSettings::table() {
         .real(&N::energy_rounding, "Energy rounding", 1e-12, Range::closed(0.0, 1e-6),
               "the slack of the sufficient-decrease test, relative to Σ|terms of E|: E's terms cancel to "
               "rounding, so a converged step may not decrease E measurably")
+        .real(&N::residual_fallback, "Residual fallback", 100.0, Range::closed(0.0, 1e12),
+              "near convergence E's rounding can hide any decrease: when no step length passes the energy test "
+              "and the residual is below this many times the tolerance, take the longest step (halving) that "
+              "reduces the residual instead; 0: never")
         .choice(&N::hessian_projection, "Hessian projection", HessianProjection::adaptive,
                 {{"always", HessianProjection::always}, {"adaptive", HessianProjection::adaptive},
                  {"never", HessianProjection::never}},
@@ -45,7 +54,12 @@ const ParameterTable<NewtonSettings>& NewtonSettings::table() {
               "largest CG tolerance of inexact Newton (used at the first iteration)")
         .real(&N::forcing_gamma, "Forcing gamma", 0.9, Range::open_closed(0.0, 1.0), "γ of the Eisenstat-Walker forcing")
         .real(&N::forcing_exponent, "Forcing exponent", 2.0, Range::open_closed(1.0, 2.0),
-              "α of the Eisenstat-Walker forcing");
+              "α of the Eisenstat-Walker forcing")
+        .integer(&N::lbfgs_pairs, "L-BFGS pairs", 8, Range::closed(1, 100),
+                 "L-BFGS: the (step, gradient change) pairs kept")
+        .integer(&N::lbfgs_rebuild, "L-BFGS rebuild", 0, Range::closed(0, 1000000),
+                 "L-BFGS: assemble the projected H and set its preconditioner up again after this many iterations "
+                 "(0: once per step); also when the line search fails with an older one");
     return table;
   }();
   return t;

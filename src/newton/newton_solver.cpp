@@ -1,6 +1,7 @@
 #include "viscompm/newton/newton_solver.hpp"
 
 #include <Teuchos_TimeMonitor.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -10,7 +11,7 @@
 namespace viscompm::newton {
 
 namespace {
-// The Newton phases' timers (doc/architecture.md), all here.
+// The phases' timers (doc/architecture.md), all here.
 Teuchos::Time& timer(const char* name) { return *Teuchos::TimeMonitor::getNewCounter(name); }
 Teuchos::Time& assemble_timer() { static auto& t = timer("viscompm: 3a newton assemble"); return t; }
 Teuchos::Time& precondition_timer() { static auto& t = timer("viscompm: 3b newton precondition"); return t; }
@@ -61,34 +62,38 @@ struct NewtonSolver::Step {
   NodeVectorField& v;
   const SystemObserver& observer;
   NewtonReport report;
-  bool assembled_this_step = false;
-  bool preconditioned_this_step = false;
   NodeVectorField v_trial;
+  // L-BFGS: the last accepted step and the gradient it started from (the next pair, once the new
+  // gradient is known), and the iterations since H₀ was built.
+  NodeVectorField lbfgs_step, lbfgs_gradient;
+  int lbfgs_age = -1;  // -1: no H₀ this step
 };
 
 NewtonSolver::NewtonSolver(const NewtonSettings& settings, linalg::NewtonSystem& system,
                            const parallel::Communicator& comm)
-    : settings_(settings), system_(system), comm_(comm) {}
+    : settings_(settings),
+      owned_system_(make_linear_system(system)),
+      system_(*owned_system_),
+      comm_(comm),
+      rules_(settings),
+      lbfgs_(settings.lbfgs_pairs) {}
 
-void NewtonSolver::forget() {
-  hessian_kept_ = false;
-  refresh_hessian_ = false;
-  refresh_preconditioner_ = true;
-}
+NewtonSolver::NewtonSolver(const NewtonSettings& settings, LinearSystem& system, const parallel::Communicator& comm)
+    : settings_(settings), system_(system), comm_(comm), rules_(settings), lbfgs_(settings.lbfgs_pairs) {}
+
+NewtonSolver::~NewtonSolver() = default;
+
+void NewtonSolver::forget() { rules_.forget(); }
 
 NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential, NodeVectorField& v,
                                  const SystemObserver& observer) {
-  Step step{potential, v, observer, {}, false, false, {}};
+  Step step{potential, v, observer, {}, {}, {}, {}, -1};
   NewtonReport& report = step.report;
   report.tolerance = settings_.tolerance * potential.layout().geometry.dx / potential.dt();
-  // A Hessian kept from an earlier step is usable only on the same graph and Δt (and only
-  // assembled: matrix-free pieces belong to their step's particles).
-  if (settings_.hessian_update != HessianUpdate::lagged || system_.matrix_free() ||
-      kept_pattern_ != system_.pattern_version() || kept_dt_ != potential.dt())
-    hessian_kept_ = false;
-  // A preconditioner of another Δt's H (H = M + Δt² K) is refreshed.
-  if (preconditioner_dt_ != potential.dt()) refresh_preconditioner_ = true;
+  rules_.begin_solve(potential.dt(), system_.pattern_version(), system_.matrix_free());
+  lbfgs_.clear();
   NodeVectorField g, dv;
+  // At most max_iterations directions; each pass ends in `break` or one more direction.
   for (;;) {
     // Residual: g = ∇E(v), complete on the owned nodes.
     {
@@ -102,8 +107,7 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
       }
     }
     const double residual = velocity_residual(potential, g, comm_);
-    if (!report.residual_history.empty() && residual > settings_.refresh_contraction * report.residual_history.back())
-      refresh_hessian_ = true;  // a kept H no longer contracts the residual well enough
+    if (!report.residual_history.empty()) rules_.residual(report.residual_history.back(), residual);
     report.residual = residual;
     report.residual_history.push_back(residual);
 
@@ -120,20 +124,25 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
       report.failure = "no convergence in " + std::to_string(settings_.max_iterations) + " iterations";
       break;
     }
-    // A stop request on any rank abandons the solve (one agreement per iteration).
-    if (interrupt_ && comm_.any(interrupt_())) {
-      report.interrupted = true;
-      report.failure = "interrupted by a stop request";
-      break;
-    }
+    if (stop_requested(step)) break;
     ++report.iterations;
 
-    // Direction H dv = −∇E, then the line search along it (both inside: a failed line search
-    // may call for a fresh or projected Hessian).
-    if (!direction_and_line_search(step, g, dv)) break;
+    // Direction, then the line search along it (both inside: a failed line search may call for a
+    // fresh or projected Hessian).
+    const bool moved = settings_.method == Method::lbfgs ? lbfgs_direction_and_line_search(step, g, dv)
+                                                         : newton_direction_and_line_search(step, g, dv);
+    if (!moved) break;
   }
   if (!report.converged) forget();
   return report;
+}
+
+bool NewtonSolver::stop_requested(Step& step) const {
+  // One agreement across ranks per question.
+  if (!interrupt_ || !comm_.any(interrupt_())) return false;
+  step.report.interrupted = true;
+  step.report.failure = "interrupted by a stop request";
+  return true;
 }
 
 double NewtonSolver::forcing(const Step& step) const {
@@ -154,92 +163,147 @@ double NewtonSolver::forcing(const Step& step) const {
 }
 
 void NewtonSolver::assemble(Step& step, bool project) {
-  {
-    Teuchos::TimeMonitor t(assemble_timer());
-    const double seconds = system_.assemble(step.potential, step.v, project);
-    step.report.linear_solves.emplace_back();  // the solve this assembly is for
-    step.report.linear_solves.back().operator_seconds = seconds;
-  }
+  Teuchos::TimeMonitor t(assemble_timer());
+  const double seconds = system_.assemble(step.potential, step.v, project);
+  step.report.linear_solves.back().operator_seconds += seconds;
   ++step.report.assemblies;
-  hessian_kept_ = true;
-  kept_projected_ = project;
-  kept_dt_ = step.potential.dt();
-  kept_pattern_ = system_.pattern_version();
-  hessian_baseline_cg_ = -1;
-  refresh_hessian_ = false;
-  step.assembled_this_step = true;
-  // The preconditioner follows the new values as the strategy says.
-  const bool setup = !system_.preconditioned() || refresh_preconditioner_ ||
-                     settings_.preconditioner_update == PreconditionerUpdate::every_assembly ||
-                     (settings_.preconditioner_update == PreconditionerUpdate::every_step && !step.preconditioned_this_step);
-  if (setup) {
-    Teuchos::TimeMonitor t(precondition_timer());
-    step.report.linear_solves.back().setup_seconds = system_.precondition();
-    ++step.report.preconditioner_setups;
-    preconditioner_dt_ = step.potential.dt();
-    preconditioner_baseline_cg_ = -1;
-    refresh_preconditioner_ = false;
-    step.preconditioned_this_step = true;
-  }
+  rules_.assembled(project);
 }
 
-bool NewtonSolver::direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv) {
-  NewtonReport& report = step.report;
-  const std::size_t owned = step.potential.layout().owned_count;
+void NewtonSolver::precondition(Step& step) {
+  Teuchos::TimeMonitor t(precondition_timer());
+  step.report.linear_solves.back().setup_seconds += system_.precondition();
+  ++step.report.preconditioner_setups;
+  rules_.preconditioned();
+}
+
+bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv) {
   NodeVectorField rhs(g.size());
   for (std::size_t i = 0; i < g.size(); ++i) rhs[i] = -g[i];
   const double tolerance = forcing(step);
-  const bool may_project = settings_.hessian_projection != HessianProjection::never;
-  bool project = settings_.hessian_projection == HessianProjection::always;
-  // A fresh H at every iteration, at the first of each step, or when the refresh rule fired.
-  bool fresh = settings_.hessian_update == HessianUpdate::every_iteration || !hessian_kept_ || refresh_hessian_ ||
-               (settings_.hessian_update == HessianUpdate::every_step && !step.assembled_this_step);
-  for (;;) {
-    if (fresh) assemble(step, project);
-    else report.linear_solves.emplace_back();
-    if (step.observer && fresh) step.observer(report.iterations, system_, rhs);
-    linalg::LinearSolveReport& solve = report.linear_solves.back();
+  const bool adaptive = settings_.hessian_projection == HessianProjection::adaptive;
+  const bool always = settings_.hessian_projection == HessianProjection::always;
+  // The attempts, in order: (1) as the strategy says — a kept or fresh H, exact unless projection
+  // is always on or the kept H is projected; (2) a fresh H and preconditioner, if (1) used anything
+  // kept; (3) the fresh projected H, if the last H was exact and projection is adaptive.
+  Attempt attempt{rules_.assemble_now(), always};
+  if (!attempt.fresh) attempt.project = rules_.kept_projected();
+  for (int k = 0; k < direction_attempts; ++k) {
+    if (k > 0 && stop_requested(step)) return false;
+    bool used_kept = false;
+    if (try_newton_direction(step, rhs, tolerance, attempt, dv, used_kept)) return true;
+    if (used_kept) {
+      attempt = {true, always || (attempt.project && !adaptive)};
+    } else if (!attempt.project && adaptive) {
+      attempt = {true, true};
+    } else {
+      break;
+    }
+    rules_.demand_fresh();  // the next attempt sets up its own preconditioner
+  }
+  if (step.report.failure.empty())
+    step.report.failure = "no direction with sufficient decrease (the last: " +
+                          std::string(step.report.linear_solves.back().converged ? "line search failed"
+                                                                                 : "linear solve failed") + ")";
+  return false;
+}
+
+bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, double tolerance,
+                                        const Attempt& attempt, NodeVectorField& dv, bool& used_kept) {
+  NewtonReport& report = step.report;
+  report.linear_solves.emplace_back();  // the solve of this attempt
+  if (attempt.fresh) {
+    assemble(step, attempt.project);
+    if (step.observer && system_.newton_system()) step.observer(report.iterations, *system_.newton_system(), rhs);
+  }
+  if (rules_.setup_now()) precondition(step);
+  used_kept = !attempt.fresh || !rules_.preconditioner_matches_hessian();
+  linalg::LinearSolveReport& solve = report.linear_solves.back();
+  {
+    Teuchos::TimeMonitor t(cg_timer());
+    const linalg::LinearSolveReport cg = system_.solve(rhs, dv, tolerance);
+    solve.iterations = cg.iterations;
+    solve.relative_residual = cg.relative_residual;
+    solve.solve_seconds = cg.solve_seconds;
+    solve.converged = cg.converged;
+    solve.tolerance = cg.tolerance;
+    solve.preconditioner = cg.preconditioner;
+    solve.failure = cg.failure;
+  }
+  report.projected_solves += attempt.project;
+  rules_.solved(solve.iterations);
+
+  step.potential.constraints().project(dv);
+  const double slope = -owned_dot(rhs, dv, step.potential.layout().owned_count, comm_);  // ∇E·dv
+  // An unconverged solve of the exact H may point anywhere; with the projected H (SPD) any CG
+  // iterate is a descent direction.
+  const bool usable = slope < 0.0 && (solve.converged || attempt.project ||
+                                      settings_.hessian_projection == HessianProjection::never);
+  return usable && line_search(step, dv, slope);
+}
+
+void NewtonSolver::rebuild_initial_inverse(Step& step) {
+  step.report.linear_solves.back().preconditioner = system_.label();
+  assemble(step, true);
+  precondition(step);
+  lbfgs_.clear();
+  step.lbfgs_age = 0;
+}
+
+bool NewtonSolver::lbfgs_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv) {
+  NewtonReport& report = step.report;
+  const std::size_t owned = step.potential.layout().owned_count;
+  const auto& constraints = step.potential.constraints();
+  const LbfgsMemory::Dot dot = [&](const NodeVectorField& a, const NodeVectorField& b) {
+    return owned_dot(a, b, owned, comm_);
+  };
+  // The gradient in the constrained subspace, and the pair of the last accepted step.
+  NodeVectorField gradient = g;
+  constraints.project(gradient);
+  if (step.lbfgs_age > 0) {
+    NodeVectorField y(gradient.size());
+    for (std::size_t i = 0; i < y.size(); ++i) y[i] = gradient[i] - step.lbfgs_gradient[i];
+    lbfgs_.add(std::move(step.lbfgs_step), std::move(y), dot);
+  }
+  const LbfgsMemory::InitialInverse initial = [&](const NodeVectorField& r, NodeVectorField& z) {
+    system_.apply_preconditioner(r, z);
+    constraints.project(z);
+  };
+  // At most two tries: with the H₀ at hand, then (if it was built at an earlier iteration) with
+  // H₀ rebuilt at the current state and the pairs forgotten.
+  for (int k = 0; k < 2; ++k) {
+    if (k > 0 && stop_requested(step)) return false;
+    report.linear_solves.emplace_back();
+    linalg::LinearSolveReport& row = report.linear_solves.back();
+    const bool rebuild = step.lbfgs_age < 0 || k > 0 ||
+                         (settings_.lbfgs_rebuild > 0 && step.lbfgs_age >= settings_.lbfgs_rebuild);
+    if (rebuild) rebuild_initial_inverse(step);
     {
       Teuchos::TimeMonitor t(cg_timer());
-      const linalg::LinearSolveReport cg = system_.solve(rhs, dv, tolerance);
-      solve.iterations = cg.iterations;
-      solve.relative_residual = cg.relative_residual;
-      solve.solve_seconds = cg.solve_seconds;
-      solve.setup_seconds += cg.setup_seconds;
-      solve.converged = cg.converged;
-      solve.tolerance = cg.tolerance;
-      solve.preconditioner = cg.preconditioner;
+      const auto start = std::chrono::steady_clock::now();
+      lbfgs_.direction(gradient, dv, dot, initial, system_.unpreconditioned());
+      constraints.project(dv);
+      row.solve_seconds = seconds_since(start);
     }
-    const bool used_projection = fresh ? project : kept_projected_;
-    report.projected_solves += used_projection;
-    // The refresh rule: CG slowing down means the kept H or preconditioner has gone stale.
-    if (hessian_baseline_cg_ < 0) hessian_baseline_cg_ = solve.iterations;
-    else if (solve.iterations > settings_.refresh_growth * hessian_baseline_cg_) refresh_hessian_ = true;
-    if (preconditioner_baseline_cg_ < 0) preconditioner_baseline_cg_ = solve.iterations;
-    else if (settings_.preconditioner_update == PreconditionerUpdate::lagged &&
-             solve.iterations > settings_.refresh_growth * preconditioner_baseline_cg_)
-      refresh_preconditioner_ = true;
-
-    step.potential.constraints().project(dv);
-    const double slope = -owned_dot(rhs, dv, owned, comm_);  // ∇E·dv
-    const bool usable = slope < 0.0 && (solve.converged || used_projection || !may_project);
-    if (usable && line_search(step, dv, slope)) return true;
-    // A kept H or preconditioner that failed is replaced by a fresh one; a fresh exact H by the
-    // projected one.
-    const bool preconditioner_kept =
-        solve.setup_seconds == 0.0 && settings_.preconditioner_update != PreconditionerUpdate::every_assembly;
-    if (!fresh || preconditioner_kept) {
-      fresh = true;
-      refresh_preconditioner_ = true;
-      project = settings_.hessian_projection == HessianProjection::always;
-      continue;
+    // One preconditioner application stands for the linear solve (solver.csv).
+    row.iterations = 1;
+    row.relative_residual = std::numeric_limits<double>::quiet_NaN();
+    row.converged = true;
+    row.preconditioner = system_.label();
+    ++report.projected_solves;
+    const double slope = dot(gradient, dv);
+    if (slope < 0.0 && line_search(step, dv, slope)) {
+      step.lbfgs_step = dv;
+      const double alpha = report.step_lengths.back();
+      for (auto& x : step.lbfgs_step) x *= alpha;
+      step.lbfgs_gradient = std::move(gradient);
+      ++step.lbfgs_age;
+      return true;
     }
-    if (used_projection || !may_project) {
-      report.failure = usable ? "line search found no decrease" : "the linear solve gave no descent direction";
-      return false;
-    }
-    project = true;
+    if (rebuild) break;  // a fresh H₀ failed: nothing fresher to try
   }
+  report.failure = "L-BFGS found no direction with sufficient decrease";
+  return false;
 }
 
 bool NewtonSolver::line_search(Step& step, const NodeVectorField& dv, double slope) {
@@ -251,21 +315,45 @@ bool NewtonSolver::line_search(Step& step, const NodeVectorField& dv, double slo
   const GlobalEnergy e0 = global_energy(step.potential, step.v, comm_);
   double alpha = 1.0;
   bool accepted = false;
-  for (int k = 0; k < settings_.max_line_search_steps; ++k, alpha *= 0.5) {
-    step.v_trial = step.v;
-    for (std::size_t i = 0; i < step.v.size(); ++i) step.v_trial[i] += alpha * dv[i];
+  for (int k = 0; k < settings_.max_line_search_steps; ++k) {
+    trial_point(step, dv, alpha);
     const GlobalEnergy e = global_energy(step.potential, step.v_trial, comm_);
-    if (e.value <= e0.value + settings_.armijo * alpha * slope + settings_.energy_rounding * e0.magnitude) {
-      report.step_lengths.push_back(alpha);
-      step.v.swap(step.v_trial);
-      accepted = true;
-      break;
-    }
+    accepted = e.value <= e0.value + settings_.armijo * alpha * slope + settings_.energy_rounding * e0.magnitude;
+    if (accepted) break;
     ++report.backtracks;
+    alpha *= 0.5;
   }
-  if (accepted && alpha < 1.0) refresh_hessian_ = true;  // the refresh rule: a shortened step
+  // Near the tolerance E's rounding may exceed any decrease a step can make: the residual decides.
+  if (!accepted && report.residual <= settings_.residual_fallback * report.tolerance)
+    accepted = residual_decrease(step, dv, alpha);
+  if (accepted) {
+    report.step_lengths.push_back(alpha);
+    step.v.swap(step.v_trial);
+    rules_.line_search_step(alpha);
+  }
   report.line_search_seconds += seconds_since(start);
   return accepted;
+}
+
+void NewtonSolver::trial_point(Step& step, const NodeVectorField& dv, double alpha) const {
+  step.v_trial = step.v;
+  for (std::size_t i = 0; i < step.v.size(); ++i) step.v_trial[i] += alpha * dv[i];
+}
+
+bool NewtonSolver::residual_decrease(Step& step, const NodeVectorField& dv, double& alpha) {
+  NodeVectorField g;
+  alpha = 1.0;
+  for (int k = 0; k < settings_.max_line_search_steps; ++k) {
+    trial_point(step, dv, alpha);
+    const bool feasible = step.potential.gradient(step.v_trial, g);
+    if (!comm_.any(!feasible) && velocity_residual(step.potential, g, comm_) < step.report.residual) {
+      ++step.report.residual_fallbacks;
+      return true;
+    }
+    ++step.report.backtracks;
+    alpha *= 0.5;
+  }
+  return false;
 }
 
 std::string NewtonReport::history() const {

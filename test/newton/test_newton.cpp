@@ -74,6 +74,100 @@ TEST_F(NewtonOnASpinningBlock, AStopRequestOnOneRankEndsTheSolveOnEveryRankAfter
   EXPECT_EQ(asked, 3);
 }
 
+namespace {
+// The simulation's system, except that every linear solve fails: CG reports no convergence and an
+// ascent direction. Counts what Newton asks of it.
+class FailingSystem : public newton::LinearSystem {
+ public:
+  explicit FailingSystem(linalg::NewtonSystem& system) : real_(newton::make_linear_system(system)) {}
+  double assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
+    ++assemblies;
+    projected_assemblies += project;
+    return real_->assemble(potential, v, project);
+  }
+  double precondition() override {
+    ++setups;
+    return real_->precondition();
+  }
+  linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) override {
+    ++solves;
+    if (!failing) return real_->solve(rhs, dv, tolerance);
+    dv.resize(rhs.size());
+    for (std::size_t i = 0; i < rhs.size(); ++i) dv[i] = -rhs[i];  // +∇E: uphill
+    linalg::LinearSolveReport report;
+    report.iterations = 7;
+    report.converged = false;
+    report.tolerance = tolerance;
+    return report;
+  }
+  void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z) override { real_->apply_preconditioner(r, z); }
+  bool unpreconditioned() const override { return real_->unpreconditioned(); }
+  std::uint64_t pattern_version() const override { return real_->pattern_version(); }
+  double default_tolerance() const override { return real_->default_tolerance(); }
+  bool matrix_free() const override { return real_->matrix_free(); }
+  std::string label() const override { return "failing"; }
+
+  bool failing = true;
+  int assemblies = 0, projected_assemblies = 0, setups = 0, solves = 0;
+
+ private:
+  std::unique_ptr<newton::LinearSystem> real_;
+};
+}  // namespace
+
+TEST_F(NewtonOnASpinningBlock, WhenEverySolveFailsEachDirectionEndsAfterAtMostThreeAttempts) {
+  // The strategies that keep H or its preconditioner: a kept one that fails is replaced by a fresh
+  // one, an exact H that fails by the projected one, and then Newton gives up — for the first
+  // direction of a step (nothing kept yet: fresh exact, then fresh projected) and for one whose H
+  // and preconditioner were kept from an earlier step (kept, fresh exact, fresh projected).
+  for (const char* update : {"every step", "lagged"}) {
+    newton::NewtonSettings settings = scene.newton;
+    settings.hessian_projection = newton::HessianProjection::adaptive;
+    settings.hessian_update = newton::HessianUpdate::lagged;
+    settings.preconditioner_update =
+        std::string(update) == "lagged" ? newton::PreconditionerUpdate::lagged : newton::PreconditionerUpdate::every_step;
+    FailingSystem failing(sim.integrator().newton_system());
+    newton::NewtonSolver solver(settings, failing, comm);
+    NodeVectorField v_first = v;
+    const auto first = solver.solve(*objective->potential, v_first);
+    EXPECT_FALSE(first.converged) << update;
+    EXPECT_EQ(first.iterations, 1) << update;
+    EXPECT_EQ(failing.solves, 2) << update;
+    EXPECT_EQ(failing.projected_assemblies, 1) << update;
+    EXPECT_EQ(first.linear_solves.size(), 2u) << update;
+    EXPECT_FALSE(first.failure.empty()) << update;
+
+    // H and the preconditioner kept from a successful solve, then failures.
+    newton::NewtonSolver keeping(settings, failing, comm);
+    failing.failing = false;
+    NodeVectorField v_converged = v;
+    ASSERT_TRUE(keeping.solve(*objective->potential, v_converged).converged) << update;
+    failing.failing = true;
+    failing.solves = failing.assemblies = failing.projected_assemblies = failing.setups = 0;
+    NodeVectorField v_kept = v;
+    const auto second = keeping.solve(*objective->potential, v_kept);
+    EXPECT_FALSE(second.converged) << update;
+    EXPECT_EQ(second.iterations, 1) << update;
+    EXPECT_EQ(failing.solves, newton::NewtonSolver::direction_attempts) << update;
+    EXPECT_EQ(failing.assemblies, 2) << update;
+    EXPECT_EQ(failing.projected_assemblies, 1) << update;
+    EXPECT_EQ(failing.setups, 2) << update;
+  }
+}
+
+TEST_F(NewtonOnASpinningBlock, AStopRequestBetweenAttemptsEndsTheSolve) {
+  newton::NewtonSettings settings = scene.newton;
+  settings.hessian_projection = newton::HessianProjection::adaptive;
+  FailingSystem failing(sim.integrator().newton_system());
+  newton::NewtonSolver solver(settings, failing, comm);
+  int asked = 0;
+  solver.set_interrupt([&] { return ++asked == 2; });  // after the first attempt of the first direction
+  const auto report = solver.solve(*objective->potential, v);
+  EXPECT_TRUE(report.interrupted);
+  EXPECT_EQ(failing.solves, 1);
+  EXPECT_EQ(asked, 2);
+}
+
 TEST(Newton, FreeFallMatchesTheExactMotion) {
   const Vec3 g(0.0, -9.81, 0.0), v0(0.5, 1.0, -0.25), lower(0.8, 1.6, 0.8);
   auto scene = testkit::base_scene(Vec3(2.0, 2.4, 2.0), 0.1);

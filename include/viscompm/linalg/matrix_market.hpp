@@ -15,7 +15,8 @@ namespace viscompm::linalg {
 
 struct MatrixMarketSolve {
   LinearSolveReport report;
-  double apply_seconds = 0.0;  ///< one application of A (mean of a few)
+  double apply_seconds = 0.0;                 ///< one application of A (mean of a few)
+  double preconditioner_apply_seconds = 0.0;  ///< one application of the preconditioner (mean of a few)
 };
 
 /// The right-hand side and coordinate files that go with a matrix file: X.mtx → X_rhs.mtx,

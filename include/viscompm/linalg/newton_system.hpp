@@ -43,6 +43,11 @@ class NewtonSystem {
   /// with the last preconditioner (set up first if there is none); rhs on the owned nodes, dv
   /// returned on all local nodes.
   LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance = 0.0);
+  /// z = P⁻¹ r, one application of the current preconditioner (set up first if there is none;
+  /// z = r without one); r on the owned nodes, z returned on all local nodes. Collective.
+  void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z);
+  /// False for a configuration without a preconditioner.
+  bool has_preconditioner() const;
   /// Global rows of each level of a multigrid preconditioner, finest first (empty otherwise).
   std::vector<std::int64_t> preconditioner_levels() const;
   /// Every entry of level `level` of a multigrid preconditioner as (row, column, value) in that

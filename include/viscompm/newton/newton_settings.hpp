@@ -1,12 +1,20 @@
-// The parameters of Newton's method on the incremental potential (the scene's `Newton` list):
-// convergence, line search, when each particle Hessian is projected to PSD, and the strategy that
-// decides how often the Hessian and its preconditioner are rebuilt and how exactly each linear
-// system is solved. Declared once with defaults, ranges and doc strings; enums parsed once.
+// The parameters of the minimisation of the incremental potential (the scene's `Newton` list):
+// the method (Newton, or L-BFGS as in HOT), convergence, line search, when each particle Hessian
+// is projected to PSD, and the strategy that decides how often the Hessian and its
+// preconditioner are rebuilt and how exactly each linear system is solved. Declared once with
+// defaults, ranges and doc strings; enums parsed once.
 #pragma once
 
 #include "viscompm/core/parameters.hpp"
 
 namespace viscompm::newton {
+
+/// How each iteration's direction is found.
+enum class Method {
+  newton,  ///< solve H dv = −∇E with the configured Krylov solver and preconditioner
+  lbfgs    ///< L-BFGS whose initial inverse Hessian is one preconditioner application on the
+           ///< SPD-projected H (Wang et al. 2020, "HOT"); no Krylov solve
+};
 
 /// When each particle's ∂²Φ/∂A² is clamped to PSD so that H is SPD: always; only when the exact
 /// Hessian fails (CG meets negative curvature, no descent, no decrease); never.
@@ -34,11 +42,13 @@ enum class LinearTolerance {
 };
 
 struct NewtonSettings {
+  Method method = Method::newton;
   int max_iterations = 20;
   double tolerance = 1e-6;
   int max_line_search_steps = 20;
   double armijo = 1e-4;
   double energy_rounding = 1e-12;
+  double residual_fallback = 100.0;
   HessianProjection hessian_projection = HessianProjection::adaptive;
   HessianUpdate hessian_update = HessianUpdate::every_iteration;
   PreconditionerUpdate preconditioner_update = PreconditionerUpdate::every_assembly;
@@ -48,6 +58,8 @@ struct NewtonSettings {
   double forcing_max = 0.1;
   double forcing_gamma = 0.9;
   double forcing_exponent = 2.0;
+  int lbfgs_pairs = 8;
+  int lbfgs_rebuild = 0;
 
   static const ParameterTable<NewtonSettings>& table();
 };

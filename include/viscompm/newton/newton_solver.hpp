@@ -1,31 +1,39 @@
-// Newton's method on the incremental potential (§5.7, with the optimisation integrator of Gast
-// et al. 2015): one bounded loop whose iterations have named steps —
-//   residual → convergence test → direction (assemble, precondition, CG) → line search —
-// and a strategy (NewtonSettings) that decides when H and its preconditioner are rebuilt, which
-// may keep them across iterations and steps, and how exactly each linear system is solved.
+// Minimisation of the incremental potential (§5.7, with the optimisation integrator of Gast et
+// al. 2015): one loop, bounded by `Max iterations`, whose iterations have named steps —
+//   residual → convergence test → stop request → direction → line search —
+// where the direction is Newton's (assemble, precondition, Krylov solve; at most
+// `direction_attempts` tries, each with fresher or projected matrices) or L-BFGS's (two-loop
+// recursion on one preconditioner application of the projected H; HOT, Wang et al. 2020).
+// ReuseRules decides when H and its preconditioner are rebuilt; LinearSystem is the seam to
+// linalg/.
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "viscompm/implicit/incremental_potential.hpp"
 #include "viscompm/linalg/linear_solver.hpp"
 #include "viscompm/linalg/newton_system.hpp"
+#include "viscompm/newton/lbfgs_memory.hpp"
+#include "viscompm/newton/linear_system.hpp"
 #include "viscompm/newton/newton_settings.hpp"
+#include "viscompm/newton/reuse_rules.hpp"
 
 namespace viscompm::newton {
 
 struct NewtonReport {
   bool converged = false;
-  int iterations = 0;                          ///< Newton iterations (directions computed)
+  int iterations = 0;                          ///< iterations (directions computed)
   double residual = 0.0;                       ///< final ‖g‖_{M⁻¹} / √(Σm) [velocity]
   double tolerance = 0.0;                      ///< the residual it had to reach
   std::vector<double> residual_history;        ///< residual before each iteration and at the end
-  std::vector<linalg::LinearSolveReport> linear_solves;
+  std::vector<linalg::LinearSolveReport> linear_solves;  ///< one per Krylov solve (L-BFGS: per direction)
   std::vector<double> step_lengths;            ///< accepted line-search step α per iteration
   int projected_solves = 0;                    ///< solves with the PSD-projected Hessian
   int backtracks = 0;                          ///< line-search halvings, all iterations
+  int residual_fallbacks = 0;                  ///< steps accepted on the residual (Residual fallback)
   int assemblies = 0;                          ///< H assembled (or its matrix-free pieces prepared)
   int preconditioner_setups = 0;
   double gradient_seconds = 0.0;               ///< ∇E evaluations
@@ -48,7 +56,15 @@ using SystemObserver =
 
 class NewtonSolver {
  public:
+  /// Tries per Newton direction: as the strategy says; with a fresh H and preconditioner if a kept
+  /// one was used; with the PSD-projected H if the exact one failed (Hessian projection adaptive).
+  static constexpr int direction_attempts = 3;
+
+  /// On the simulation's system.
   NewtonSolver(const NewtonSettings& settings, linalg::NewtonSystem& system, const parallel::Communicator& comm);
+  /// On any system (tests); `system` must outlive the solver.
+  NewtonSolver(const NewtonSettings& settings, LinearSystem& system, const parallel::Communicator& comm);
+  ~NewtonSolver();
 
   /// Minimises E from the initial guess v (constraints already applied); v holds the result.
   /// Collective.
@@ -58,31 +74,37 @@ class NewtonSolver {
   /// checkpoint), so that the next solve starts as a fresh run would.
   void forget();
   /// A request to abandon the solve (e.g. a stop signal on this rank), asked before every
-  /// iteration's direction; the ranks agree, so one rank's request ends every rank's solve.
+  /// iteration's direction and before each further attempt at one; the ranks agree, so one rank's
+  /// request ends every rank's solve.
   void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
   const NewtonSettings& settings() const { return settings_; }
 
  private:
   struct Step;  // the state of one solve
-  bool direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv);
+  struct Attempt {
+    bool fresh;    // assemble H now (else the kept one)
+    bool project;  // the PSD-projected H
+  };
+  bool stop_requested(Step& step) const;
+  bool newton_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv);
+  bool try_newton_direction(Step& step, const NodeVectorField& rhs, double tolerance, const Attempt& attempt,
+                            NodeVectorField& dv, bool& used_kept);
+  bool lbfgs_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv);
+  void rebuild_initial_inverse(Step& step);
   bool line_search(Step& step, const NodeVectorField& dv, double slope);
+  void trial_point(Step& step, const NodeVectorField& dv, double alpha) const;
+  bool residual_decrease(Step& step, const NodeVectorField& dv, double& alpha);
   double forcing(const Step& step) const;
   void assemble(Step& step, bool project);
+  void precondition(Step& step);
 
   NewtonSettings settings_;
-  linalg::NewtonSystem& system_;
+  std::unique_ptr<LinearSystem> owned_system_;
+  LinearSystem& system_;
   parallel::Communicator comm_;
   std::function<bool()> interrupt_;
-  // What is kept from earlier iterations and solves.
-  bool hessian_kept_ = false;           // the system holds an H assembled earlier
-  bool kept_projected_ = false;
-  double kept_dt_ = 0.0;
-  std::uint64_t kept_pattern_ = 0;
-  int hessian_baseline_cg_ = -1;        // CG iterations of the first solve after the last assembly
-  int preconditioner_baseline_cg_ = -1; // ... after the last preconditioner set-up
-  double preconditioner_dt_ = 0.0;      // the Δt of the H the preconditioner was set up for
-  bool refresh_hessian_ = false;
-  bool refresh_preconditioner_ = false;
+  ReuseRules rules_;
+  LbfgsMemory lbfgs_;
 };
 
 }  // namespace viscompm::newton

@@ -1,6 +1,7 @@
 // The one place that spells the Tpetra template arguments. This Trilinos is instantiated for
 // Scalar = double, LocalOrdinal = int, GlobalOrdinal = long long on the Kokkos Serial node; no
-// other file repeats them. Include only from src/linalg (Trilinos headers are slow to compile).
+// other file repeats them. Private to src/linalg (not installed; Trilinos headers are slow to
+// compile and no Tpetra type leaks out of the linear-algebra layer).
 #pragma once
 
 #include <Ifpack2_Preconditioner.hpp>
@@ -9,6 +10,9 @@
 #include <MueLu_ParameterListInterpreter_fwd.hpp>
 #include <MueLu_Utilities_fwd.hpp>
 #include <MueLu_TpetraOperator_fwd.hpp>
+#include <MueLu_SmootherBase_fwd.hpp>
+#include <MueLu_Ifpack2Smoother_fwd.hpp>
+#include <MueLu_TrilinosSmoother_fwd.hpp>
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_RowMatrix_fwd.hpp>
 #include <Xpetra_Matrix_fwd.hpp>
@@ -48,6 +52,10 @@ using muelu_interpreter_type =
     MueLu::ParameterListInterpreter<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 using muelu_hierarchy_utils_type = MueLu::HierarchyUtils<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 using muelu_utilities_type = MueLu::Utilities<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_smoother_type = MueLu::SmootherBase<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_ifpack2_smoother_type = MueLu::Ifpack2Smoother<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using muelu_trilinos_smoother_type =
+    MueLu::TrilinosSmoother<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 
 static_assert(std::is_same_v<global_ordinal_type, map_type::global_ordinal_type>);
 
