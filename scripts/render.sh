@@ -5,7 +5,7 @@
 # The material is drawn as the particle surface the run wrote (Output/Surface voxel size), smooth-
 # shaded, or as spheres, or as a density field (--style); it is coloured by det b^E around 1
 # (Figure 5.7: red above, blue below) unless --field says otherwise; colliders are grey surfaces.
-# --strip joins the listed frames side by side into one small PNG (a gallery strip). Installs
+# --strip joins the listed frames side by side (4: a 2x2 grid) into one small PNG. Installs
 # ParaView, Xvfb and ffmpeg (Debian packages) when they are missing.
 #
 # Usage: scripts/render.sh OUTPUT_DIR [--style auto|surface|spheres|density] [--field NAME|none]
@@ -23,7 +23,7 @@ FPS=24
 MOVIE=1
 STRIP=""
 STRIP_FILE=""
-STRIP_WIDTH=1600
+STRIP_WIDTH=1280
 forward=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -71,8 +71,8 @@ if [ "$MOVIE" = 1 ] && [ ${#pngs[@]} -ge 2 ]; then
   echo "render.sh: $OUTPUT_DIR/render/movie.mp4 (${#pngs[@]} frames at $FPS fps)"
 fi
 
-# A strip: the listed frames side by side, scaled to STRIP_WIDTH pixels in all, in a 128-colour
-# palette (a few hundred kB at most).
+# A strip: the listed frames side by side (four as a 2x2 grid), scaled to STRIP_WIDTH pixels in
+# all, in a 256-colour palette (a few hundred kB at most).
 if [ -n "$STRIP" ]; then
   inputs=()
   IFS=',' read -r -a strip_frames <<< "$STRIP"
@@ -84,8 +84,9 @@ if [ -n "$STRIP" ]; then
   n=${#strip_frames[@]}
   stack="hstack=inputs=$n"
   [ "$n" = 1 ] && stack="null"
+  [ "$n" = 4 ] && stack="xstack=inputs=4:layout=0_0|w0_0|0_h0|w0_h0"
   ffmpeg -y -loglevel error "${inputs[@]}" -filter_complex \
-    "$stack,scale=$STRIP_WIDTH:-2:flags=lanczos,split[a][b];[a]palettegen=max_colors=128[p];[b][p]paletteuse=dither=bayer" \
+    "$stack,scale=$STRIP_WIDTH:-2:flags=lanczos,split[a][b];[a]palettegen=max_colors=256[p];[b][p]paletteuse=dither=sierra2_4a" \
     -frames:v 1 "$STRIP_FILE"
   echo "render.sh: $STRIP_FILE (frames $STRIP)"
 fi

@@ -6,8 +6,9 @@ the run wrote with Output/Surface voxel size), and writes OUTPUT_DIR/render/fram
 
 Styles:
   spheres  every particle a shaded sphere coloured by the field
-  surface  the particle surface (OpenVDB, written by the run), smooth-shaded, coloured by the
-           field interpolated from the nearest particles (Gaussian kernel of two spacings)
+  surface  the particle surface (OpenVDB, written by the run), smoothed (VTK windowed sinc) and
+           smooth-shaded, coloured by the field interpolated from the nearest particles
+           (Gaussian kernel of two spacings)
   density  the particles splatted into a density field (Gaussian, one spacing) and volume-rendered
            in a sponge colour, as the thesis rendered its sponges
   auto     surface where the run wrote surfaces, else spheres (default)
@@ -29,6 +30,8 @@ from paraview import simple
 from paraview.vtk.util import numpy_support
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkFiltersCore import vtkWindowedSincPolyDataFilter
+from vtkmodules.vtkIOGeometry import vtkOBJReader
 
 CREAM = [0.95, 0.9, 0.78]
 SPONGE = [0.93, 0.78, 0.35]
@@ -43,7 +46,8 @@ def parse():
     ap.add_argument("--size", default="1280x720", help="image size WxH (default 1280x720)")
     ap.add_argument("--frames", default="all", help="all (default), last, or frame numbers separated by commas")
     ap.add_argument("--range", nargs=2, type=float, metavar=("LO", "HI"),
-                    help="colour range (default: det_b_elastic 1 ± its largest deviation in the rendered frames)")
+                    help="colour range (default: det_b_elastic 1 ± the 95th percentile of |det b^E - 1| in the "
+                         "rendered frames)")
     ap.add_argument("--view", default="iso", choices=["iso", "x", "y", "z"], help="camera direction (default iso)")
     ap.add_argument("--azimuth", type=float, default=0.0, help="turn the camera about the up axis [degrees]")
     ap.add_argument("--elevation", type=float, default=0.0, help="raise the camera [degrees]")
@@ -97,6 +101,23 @@ def surface_polydata(vertices, triangles):
     return poly
 
 
+def smoothed_surface(path):
+    """The run's particle surface (a union of spheres, bumpy at the particle spacing) read and
+    smoothed by a windowed-sinc filter, which keeps the volume (Taubin's low-pass)."""
+    reader = vtkOBJReader()
+    reader.SetFileName(path)
+    smooth = vtkWindowedSincPolyDataFilter()
+    smooth.SetInputConnection(reader.GetOutputPort())
+    smooth.SetNumberOfIterations(40)
+    smooth.SetPassBand(0.01)
+    smooth.NonManifoldSmoothingOn()
+    smooth.NormalizeCoordinatesOn()
+    smooth.Update()
+    surface = vtkPolyData()
+    surface.ShallowCopy(smooth.GetOutput())
+    return surface
+
+
 def producer(data):
     source = simple.PVTrivialProducer()
     source.GetClientSideObject().SetOutput(data)
@@ -126,7 +147,7 @@ def surface_file(output_dir, frame):
 def scan(args, numbered, frames, kept):
     """One pass over the frames: the colour range, the particle spacing and the particles' extent
     (2nd to 98th percentile in each direction, so that a few strays do not move the camera)."""
-    lo_hi, lows, highs, volume = [math.inf, -math.inf], [], [], []
+    lo_hi, lows, highs, volume, deviations = [math.inf, -math.inf], [], [], [], []
     for f in frames:
         with h5py.File(numbered[f], "r") as h5:
             p = h5["particles"]
@@ -140,13 +161,14 @@ def scan(args, numbered, frames, kept):
             lows.append(np.percentile(x, 2, axis=0))
             highs.append(np.percentile(x, 98, axis=0))
             lo_hi = [min(lo_hi[0], values.min()), max(lo_hi[1], values.max())]
+            deviations.append(np.percentile(np.abs(values - 1.0), 95))
             volume.append(np.median(p["volume0"][...]))
     if not volume:
         sys.exit("render: the frames hold no particles")
     if args.range:
         lo, hi = args.range
     elif args.field == "det_b_elastic":
-        deviation = max(abs(lo_hi[0] - 1.0), abs(lo_hi[1] - 1.0), 1e-3)
+        deviation = max(max(deviations), 1e-3)  # the 95th percentile: a few extremes do not wash it out
         lo, hi = 1.0 - deviation, 1.0 + deviation
     else:
         lo, hi = lo_hi if lo_hi[1] > lo_hi[0] else (lo_hi[0], lo_hi[0] + 1.0)
@@ -154,14 +176,20 @@ def scan(args, numbered, frames, kept):
     return (lo, hi), spacing, np.min(lows, axis=0), np.max(highs, axis=0)
 
 
-def make_view(args, width, height, spacing, bounds_lo, bounds_hi):
+def make_view(width, height):
+    simple._DisableFirstRenderCameraReset()  # the camera is ours (place_camera)
     view = simple.CreateRenderView()
     view.ViewSize = [width, height]
     view.OrientationAxesVisibility = 0
     if hasattr(view, "UseColorPaletteForBackground"):
         view.UseColorPaletteForBackground = 0
     view.Background = [1.0, 1.0, 1.0]
-    view.EnableRenderOnInteraction = 0
+    return view
+
+
+def place_camera(view, args, spacing, bounds_lo, bounds_hi):
+    """Looks at the particles' extent (or --focus) from --view, turned by --azimuth and --elevation;
+    called after the frame is shown, since showing the first object resets the camera."""
     centre = 0.5 * (bounds_lo + bounds_hi)
     if args.focus:
         centre = np.array([float(v) for v in args.focus.split(",")])
@@ -176,7 +204,6 @@ def make_view(args, width, height, spacing, bounds_lo, bounds_hi):
     camera.Azimuth(args.azimuth)
     camera.Elevation(args.elevation)
     camera.OrthogonalizeViewUp()
-    return view
 
 
 def colour_display(display, view, args, lut, lo, hi):
@@ -204,7 +231,7 @@ def show_material(style, output_dir, frame, particles, args, view, spacing, lut,
         colour_display(display, view, args, lut, lo, hi)
         return []
     if style == "surface":
-        reader = simple.WavefrontOBJReader(FileName=surface_file(output_dir, frame))
+        reader = producer(smoothed_surface(surface_file(output_dir, frame)))
         interpolated = simple.PointDatasetInterpolator(Input=particles, Source=reader)
         interpolated.Kernel = "GaussianKernel"
         interpolated.Kernel.KernelFootprint = "Radius"
@@ -242,7 +269,7 @@ def show_material(style, output_dir, frame, particles, args, view, spacing, lut,
     return [density]
 
 
-def render_frame(args, numbered, frame, style, view, kept, spacing, lut, lo_hi, out_dir, width, height):
+def render_frame(args, numbered, frame, style, view, kept, spacing, lut, lo_hi, bounds, out_dir, size):
     with h5py.File(numbered[frame], "r") as h5:
         p = h5["particles"]
         x = p["position"][...]
@@ -260,8 +287,9 @@ def render_frame(args, numbered, frame, style, view, kept, spacing, lut, lo_hi, 
             cd.ColorArrayName = ["POINTS", ""]
             cd.AmbientColor = cd.DiffuseColor = [0.5, 0.5, 0.55]
             cd.Opacity = 0.5
+        place_camera(view, args, spacing, *bounds)
         simple.Render(view)
-        simple.SaveScreenshot(os.path.join(out_dir, f"frame_{frame:05d}.png"), view, ImageResolution=[width, height])
+        simple.SaveScreenshot(os.path.join(out_dir, f"frame_{frame:05d}.png"), view, ImageResolution=list(size))
         for s in shown:
             simple.Hide(s, view)
         for s in shown:
@@ -291,14 +319,15 @@ def main():
         return np.ones(len(x), dtype=bool) if cut is None else x[:, axis] <= cut
 
     (lo, hi), spacing, bounds_lo, bounds_hi = scan(args, numbered, frames, kept)
-    view = make_view(args, width, height, spacing, bounds_lo, bounds_hi)
+    view = make_view(width, height)
     lut = simple.GetColorTransferFunction(args.field)
     lut.ApplyPreset("Cool to Warm", True)
     lut.RescaleTransferFunction(lo, hi)
     if hasattr(lut, "AutomaticRescaleRangeMode"):
         lut.AutomaticRescaleRangeMode = "Never"
     for f in frames:
-        render_frame(args, numbered, f, style, view, kept, spacing, lut, (lo, hi), out_dir, width, height)
+        render_frame(args, numbered, f, style, view, kept, spacing, lut, (lo, hi), (bounds_lo, bounds_hi), out_dir,
+                     (width, height))
     print(f"render: {len(frames)} frame(s) of {args.output_dir} as {style}, {args.field} in [{lo:.4g}, {hi:.4g}] -> "
           f"{out_dir}/frame_NNNNN.png ({width}x{height})")
 
