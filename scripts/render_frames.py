@@ -287,6 +287,12 @@ def render_frame(args, numbered, frame, style, view, kept, spacing, lut, lo_hi, 
             cd.ColorArrayName = ["POINTS", ""]
             cd.AmbientColor = cd.DiffuseColor = [0.5, 0.5, 0.55]
             cd.Opacity = 0.5
+        label = simple.Text(Text=f"t = {float(h5.attrs['time']):.3f} s")
+        shown.append(label)
+        ld = simple.Show(label, view)
+        ld.WindowLocation = "Upper Left Corner"
+        ld.FontSize = 28
+        ld.Color = [0.1, 0.1, 0.1]
         place_camera(view, args, spacing, *bounds)
         simple.Render(view)
         simple.SaveScreenshot(os.path.join(out_dir, f"frame_{frame:05d}.png"), view, ImageResolution=list(size))
