@@ -23,8 +23,9 @@ What is measured (doc/scenes.md, "Measured behaviour"):
                      components (Figures 5.6, 5.8)
   twisting_sponge    separated pieces and torn links (lattice neighbours now far apart: the torn
                      area), the grips' turn (Figure 5.1)
-  shooting_sponge    the bullet's tunnel: particles in its path relative to frame 0 (emptied, then
-                     refilled: the recovery), pieces, torn links (Figure 5.2)
+  shooting_sponge    the sponge's deformation (rms displacement from frame 0: its peak and how far
+                     it comes back after the bullet has passed: the recovery), the bullet's tunnel
+                     (particles in its path relative to frame 0), pieces, torn links (Figure 5.2)
 """
 import argparse
 import glob
@@ -390,15 +391,26 @@ def measure_shooting(frames, scene, link_factor, tear_factor):
         return (off < radius) & (along > min(along0, far0)) & (along < max(along0, far0))
 
     count0 = int(in_tunnel(first["position"]).sum())
-    series = []
+    series, displacement = [], []
     for n in frames.numbers:
         f = frames.frame(n, fields=("id", "position"))
         series.append([round(f["time"], 4), round(int(in_tunnel(f["position"]).sum()) / max(count0, 1), 3)])
+        # The sponge's deformation: the root-mean-square displacement from frame 0 (no particle is
+        # added or removed, so the id-sorted arrays match).
+        displacement.append(float(np.sqrt(np.mean(np.sum((f["position"] - first["position"]) ** 2, axis=1)))))
     occupancy = np.array([s[1] for s in series])
     lowest = int(np.argmin(occupancy))
     result.update({"tunnel_particles_frame_0": count0, "tunnel_occupancy_by_frame": series,
                    "tunnel_occupancy_lowest": float(occupancy[lowest]), "lowest_time": series[lowest][0],
                    "tunnel_occupancy_final": float(occupancy[-1]),
+                   "rms_displacement_by_frame_m": [[s[0], round(d, 4)] for s, d in zip(series, displacement)],
+                   "rms_displacement_peak_m": max(displacement),
+                   "rms_displacement_peak_time": series[int(np.argmax(displacement))][0],
+                   "rms_displacement_final_m": displacement[-1],
+                   # It swings back elastically: how far the first return after the peak comes.
+                   "rms_displacement_first_return_m": min(displacement[int(np.argmax(displacement)):]),
+                   "recovered_fraction_first_return":
+                       1.0 - min(displacement[int(np.argmax(displacement)):]) / max(max(displacement), 1e-300),
                    "bullet_exits_sponge_s": float((max(along0, far0) - centre @ direction + radius)
                                                   / np.linalg.norm(velocity))})
     return result

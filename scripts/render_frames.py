@@ -261,10 +261,11 @@ def show_material(style, output_dir, frame, particles, args, view, spacing, lut,
     colours = simple.GetColorTransferFunction("SplatterValues")
     colours.RGBPoints = [0.0] + SPONGE + [1.0] + [0.75 * c for c in SPONGE]
     opacity = simple.GetOpacityTransferFunction("SplatterValues")
-    opacity.Points = [0.0, 0.0, 0.5, 0.0, 0.15, 0.1, 0.5, 0.0, 1.0, 0.6, 0.5, 0.0]
+    opacity.Points = [0.0, 0.0, 0.5, 0.0, 0.3, 0.0, 0.5, 0.0, 0.6, 0.1, 0.5, 0.0, 1.0, 0.5, 0.5, 0.0]
     colours.RescaleTransferFunction(0.0, 1.0)
     opacity.RescaleTransferFunction(0.0, 1.0)
     display.ScalarOpacityFunction = opacity
+    display.ScalarOpacityUnitDistance = 4.0 * spacing  # translucent: tears and thin parts show
     display.SetScalarBarVisibility(view, False)
     return [density]
 
