@@ -168,34 +168,38 @@ def measure_weissenberg(frames, scene):
 # ---------------------------------------------------------------------------------------------
 # Streams laid down: Viennetta (belt), shaving foam and toothpaste (a pile).
 
-def emission_bins(f, emitted, count):
-    """Groups the emitted particles (mask `emitted` of frame f, ids in emission order) into `count`
-    consecutive bins of equal size; returns a list of index arrays, oldest first."""
+def emission_bins(f, emitted, size):
+    """Groups the emitted particles (mask `emitted` of frame f; ids grow with the emission time) into
+    consecutive bins of about `size` particles, several of the nozzle's layers each, so that a bin's
+    centre is the stream's centre at that time; returns a list of index arrays, oldest first."""
     index = np.nonzero(emitted)[0]
     index = index[np.argsort(f["id"][index])]
-    return [b for b in np.array_split(index, count) if len(b)]
+    return [b for b in np.array_split(index, max(2, len(index) // size)) if len(b)]
 
 
 def reversals(signal, threshold):
-    """Turning points of a sequence, counting only swings larger than `threshold` (hysteresis)."""
-    turns, extreme, direction = [], signal[0], 0
+    """Indices of the turning points of a sequence, counting only swings larger than `threshold`
+    (hysteresis): the maxima and minima between them."""
+    turns, direction = [], 0
+    high = low = signal[0]
+    high_at = low_at = 0
     for i, v in enumerate(signal):
-        if direction >= 0 and v > extreme:
-            extreme, at = v, i
-        elif direction <= 0 and v < extreme:
-            extreme, at = v, i
-        if direction >= 0 and v < extreme - threshold:
+        if v > high:
+            high, high_at = v, i
+        if v < low:
+            low, low_at = v, i
+        if direction >= 0 and v < high - threshold:  # fell from a maximum
             if direction > 0:
-                turns.append(at)
-            direction, extreme, at = -1, v, i
-        elif direction <= 0 and v > extreme + threshold:
+                turns.append(high_at)
+            direction, low, low_at = -1, v, i
+        elif direction <= 0 and v > low + threshold:  # rose from a minimum
             if direction < 0:
-                turns.append(at)
-            direction, extreme, at = 1, v, i
+                turns.append(low_at)
+            direction, high, high_at = 1, v, i
     return turns
 
 
-def measure_viennetta(frames, scene):
+def measure_viennetta(frames, scene, bin_size):
     belt_speed = float(scene.get("Colliders/belt/Surface velocity")[0])
     belt_top = float(scene.get("Colliders/belt/Upper corner")[1])
     lower, upper = scene.get("Emitters/nozzle/Lower corner"), scene.get("Emitters/nozzle/Upper corner")
@@ -210,14 +214,12 @@ def measure_viennetta(frames, scene):
     if n_laid < 100:
         result["note"] = "too little material on the belt to measure folds"
         return result
-    # Emission time of each laid particle from its rank in emission order (a constant rate).
-    emitted = np.ones(len(x), dtype=bool)
-    order = np.argsort(f["id"])
-    t_emit = np.empty(len(x))
-    t_emit[order] = np.linspace(0.0, f["time"], len(x), endpoint=False)
+    # Emission time of each particle from its place in emission order (the frame is sorted by id;
+    # a constant rate from t = 0).
+    t_emit = np.linspace(0.0, f["time"], len(x), endpoint=False)
     # Where it landed: the belt has carried it belt_speed * (t - t_emit) less the (constant) fall time.
     landed = x[:, 0] - belt_speed * (f["time"] - t_emit)
-    bins = emission_bins({"id": f["id"]}, laid, max(8, n_laid // 40))
+    bins = emission_bins(f, laid, bin_size)
     signal = np.array([np.median(landed[b]) for b in bins])
     times = np.array([np.median(t_emit[b]) for b in bins])
     turns = reversals(signal, 1.0 * h)
@@ -255,7 +257,7 @@ def crests_along_belt(x, h, nozzle_x):
     return result
 
 
-def measure_pile(frames, scene):
+def measure_pile(frames, scene, bin_size):
     centre = scene.get("Emitters/nozzle/Center")
     speed = float(np.linalg.norm(scene.get("Emitters/nozzle/Velocity")))
     radius = float(scene.get("Emitters/nozzle/Radius"))
@@ -273,17 +275,21 @@ def measure_pile(frames, scene):
     offset = x[:, [0, 2]] - centre[[0, 2]]
     result.update({"pile_height_m": float(x[laid, 1].max() - base),
                    "pile_width_m": float(2.0 * np.percentile(np.linalg.norm(offset[laid], axis=1), 95))})
-    bins = emission_bins(f, laid, max(8, int(laid.sum()) // 30))
+    bins = emission_bins(f, laid, bin_size)
     path = np.array([offset[b].mean(axis=0) for b in bins])
-    # Coiling: the laid rope's centre turns about the nozzle's axis.
-    angle = np.unwrap(np.arctan2(path[:, 1], path[:, 0]))
-    far = np.linalg.norm(path, axis=1) > 0.5 * radius
-    turns = float((angle[far][-1] - angle[far][0]) / (2 * math.pi)) if far.sum() > 1 else 0.0
+    # Coiling: the laid rope's centre turns about the middle of its path; the turns are the sum of
+    # the angle steps between consecutive bins away from the middle (a step across the middle,
+    # larger than a right angle, is a fold, not a turn).
+    around = path - path.mean(axis=0)
+    far = np.linalg.norm(around, axis=1) > 0.5 * radius
+    steps = np.arctan2(np.cross(around[:-1], around[1:]), np.einsum("ij,ij->i", around[:-1], around[1:]))
+    steps = steps[far[:-1] & far[1:] & (np.abs(steps) < 0.5 * math.pi)]
+    turns = float(np.sum(steps) / (2 * math.pi))
     # Folding: it swings back and forth along its main horizontal direction.
     axis = np.linalg.svd(path - path.mean(axis=0), full_matrices=False)[2][0]
     along = path @ axis
     swings = reversals(along, radius)
-    result.update({"coil_turns": turns, "coil_radius_m": float(np.median(np.linalg.norm(path, axis=1))),
+    result.update({"coil_turns": turns, "coil_radius_m": float(np.median(np.linalg.norm(around, axis=1))),
                    "fold_reversals": len(swings), "fold_amplitude_m": float(np.ptp(along) / 2),
                    "pile_height_by_frame_m": pile_heights(frames, speed)})
     return result
@@ -427,6 +433,8 @@ def main():
                     help="particles closer than this many particle spacings are connected (default 1.5)")
     ap.add_argument("--tear", type=float, default=3.0,
                     help="a lattice link is torn when longer than this many spacings (default 3)")
+    ap.add_argument("--bin", type=int, default=400,
+                    help="streams: particles per bin of emission order, several nozzle layers (default 400)")
     ap.add_argument("--json", help="also write the measurements to this JSON file")
     args = ap.parse_args()
     name = args.scene or os.path.basename(os.path.normpath(args.output_dir))
@@ -437,9 +445,9 @@ def main():
     frames = Frames(args.output_dir)
     measure = {
         "weissenberg_sweep": lambda: measure_weissenberg(frames, scene),
-        "viennetta": lambda: measure_viennetta(frames, scene),
-        "shaving_foam": lambda: measure_pile(frames, scene),
-        "toothpaste": lambda: measure_pile(frames, scene),
+        "viennetta": lambda: measure_viennetta(frames, scene, args.bin),
+        "shaving_foam": lambda: measure_pile(frames, scene, args.bin),
+        "toothpaste": lambda: measure_pile(frames, scene, args.bin),
         "pie": lambda: measure_pie(frames, scene, args.link),
         "twisting_sponge": lambda: measure_twisting(frames, scene, args.link, args.tear),
         "shooting_sponge": lambda: measure_shooting(frames, scene, args.link, args.tear),
