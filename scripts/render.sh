@@ -33,7 +33,7 @@ while [ $# -gt 0 ]; do
     --strip-file) STRIP_FILE="$2"; shift 2 ;;
     --strip-width) STRIP_WIDTH="$2"; shift 2 ;;
     --range) forward+=("$1" "$2" "$3"); shift 3 ;;
-    --field|--style|--size|--frames|--view|--clip|--azimuth|--elevation|--zoom|--focus) forward+=("$1" "$2"); shift 2 ;;
+    --field|--style|--size|--frames|--view|--clip|--azimuth|--elevation|--zoom|--focus) forward+=("$1=$2"); shift 2 ;;  # "=": values may be negative
     *) echo "render.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
