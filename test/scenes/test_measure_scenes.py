@@ -4,6 +4,7 @@ frames (the HDF5 layout of doc/contracts.md) of a crust cut into six slices that
 pieces, none broken across) or stay together (one piece), a rope laid in three coils (three turns),
 a rope laid back and forth (reversals, no turns), three balls whose rebound grows with Wi (monotone)
 or does not (not monotone), and a sponge torn in two (two pieces, torn links)."""
+import argparse
 import json
 import os
 import shutil
@@ -15,8 +16,6 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
 from script_checks import check, finish  # noqa: E402
-
-import argparse  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--measure", required=True, help="scripts/measure_scenes.py")
