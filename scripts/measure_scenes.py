@@ -20,7 +20,8 @@ What is measured (doc/scenes.md, "Measured behaviour"):
                      pile's height and width (Figures 5.3, 5.9)
   pie                crust pieces (connected components of crust particles) against the prescored
                      slices (the stiff crust's components at frame 0), slices broken across, cream
-                     components (Figures 5.6, 5.8)
+                     components by frame (splitting), the crust's velocity along the throw by
+                     frame (does it reach the head?) (Figures 5.6, 5.8)
   twisting_sponge    separated pieces and torn links (lattice neighbours now far apart: the torn
                      area), the grips' turn (Figure 5.1)
   shooting_sponge    the sponge's deformation (rms displacement from frame 0: its peak and how far
@@ -341,6 +342,15 @@ def measure_pie(frames, scene, link_factor):
                         for q in set(stiff_pieces)), reverse=True)
     result["slices_per_crust_piece"] = [n for n in per_piece if n > 0]
     result.update({"time": last["time"], "slices_broken_across": split})
+    # Whether the crust reaches the head: its mean velocity along the throw, frame by frame.
+    throw = first["velocity"][stiff0].mean(axis=0)
+    throw /= max(np.linalg.norm(throw), 1e-300)
+    result["crust_velocity_along_throw_by_frame"] = [
+        [round(f["time"], 4), round(float(f["velocity"][f["material_id"] != cream].mean(axis=0) @ throw), 3)]
+        for f in (frames.frame(n) for n in frames.numbers)]
+    cream_counts = [len(pieces(components(f["position"][f["material_id"] == cream], link)[0], 10))
+                    for f in (frames.frame(n) for n in frames.numbers)]
+    result["cream_pieces_by_frame"] = cream_counts
     return result
 
 
