@@ -2,31 +2,42 @@
 # Renders every frame of a viscompm output directory to PNG with ParaView's pvbatch (under a
 # private Xvfb display) and makes a movie of them with ffmpeg:
 #   OUTPUT_DIR/render/frame_NNNNN.png and OUTPUT_DIR/render/movie.mp4
-# Particles are coloured by det b^E around 1 (Figure 5.7: red above, blue below) unless --field
-# says otherwise; colliders are drawn as grey surfaces. Installs ParaView, Xvfb and ffmpeg (Debian
-# packages) when they are missing.
+# The material is drawn as the particle surface the run wrote (Output/Surface voxel size), smooth-
+# shaded, or as spheres, or as a density field (--style); it is coloured by det b^E around 1
+# (Figure 5.7: red above, blue below) unless --field says otherwise; colliders are grey surfaces.
+# --strip joins the listed frames side by side (4: a 2x2 grid) into one small PNG. Installs
+# ParaView, Xvfb and ffmpeg (Debian packages) when they are missing.
 #
-# Usage: scripts/render.sh OUTPUT_DIR [--field NAME] [--size WxH] [--frames all|last|N,M,...]
-#                          [--range LO HI] [--view iso|x|y|z] [--clip x|y|z] [--fps N] [--no-movie]
+# Usage: scripts/render.sh OUTPUT_DIR [--style auto|surface|spheres|density] [--field NAME|none]
+#          [--size WxH] [--frames all|last|N,M,...] [--range LO HI] [--view iso|x|y|z]
+#          [--azimuth DEG] [--elevation DEG] [--zoom F] [--focus X,Y,Z] [--clip x|y|z]
+#          [--fps N] [--no-movie] [--strip N,M,... --strip-file FILE.png [--strip-width W]]
 set -euo pipefail
 
-usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
 if [ $# -lt 1 ] || [ "$1" = "--help" ] || [ "$1" = "-h" ]; then usage; [ $# -ge 1 ] && exit 0 || exit 2; fi
 OUTPUT_DIR="$1"; shift
 if [ ! -d "$OUTPUT_DIR" ]; then echo "render.sh: $OUTPUT_DIR: no such directory" >&2; exit 2; fi
 
 FPS=24
 MOVIE=1
+STRIP=""
+STRIP_FILE=""
+STRIP_WIDTH=1280
 forward=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --fps) FPS="$2"; shift 2 ;;
     --no-movie) MOVIE=0; shift ;;
+    --strip) STRIP="$2"; shift 2 ;;
+    --strip-file) STRIP_FILE="$2"; shift 2 ;;
+    --strip-width) STRIP_WIDTH="$2"; shift 2 ;;
     --range) forward+=("$1" "$2" "$3"); shift 3 ;;
-    --field|--size|--frames|--view|--clip) forward+=("$1" "$2"); shift 2 ;;
+    --field|--style|--size|--frames|--view|--clip|--azimuth|--elevation|--zoom|--focus) forward+=("$1=$2"); shift 2 ;;  # "=": values may be negative
     *) echo "render.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+if [ -n "$STRIP" ] && [ -z "$STRIP_FILE" ]; then echo "render.sh: --strip needs --strip-file FILE.png" >&2; exit 2; fi
 
 packages=(paraview python3-paraview python3-h5py xvfb xauth ffmpeg)
 missing=()
@@ -58,4 +69,24 @@ if [ "$MOVIE" = 1 ] && [ ${#pngs[@]} -ge 2 ]; then
   ffmpeg -y -loglevel error -framerate "$FPS" -pattern_type glob -i "$OUTPUT_DIR/render/frame_*.png" \
     -vf "scale=trunc(iw/2)*2:trunc(ih/2)*2" -c:v libx264 -pix_fmt yuv420p "$OUTPUT_DIR/render/movie.mp4"
   echo "render.sh: $OUTPUT_DIR/render/movie.mp4 (${#pngs[@]} frames at $FPS fps)"
+fi
+
+# A strip: the listed frames side by side (four as a 2x2 grid), scaled to STRIP_WIDTH pixels in
+# all, in a 256-colour palette (a few hundred kB at most).
+if [ -n "$STRIP" ]; then
+  inputs=()
+  IFS=',' read -r -a strip_frames <<< "$STRIP"
+  for f in "${strip_frames[@]}"; do
+    png=$(printf '%s/render/frame_%05d.png' "$OUTPUT_DIR" "$f")
+    [ -f "$png" ] || { echo "render.sh: $png not rendered (add frame $f to --frames)" >&2; exit 2; }
+    inputs+=(-i "$png")
+  done
+  n=${#strip_frames[@]}
+  stack="hstack=inputs=$n"
+  [ "$n" = 1 ] && stack="null"
+  [ "$n" = 4 ] && stack="xstack=inputs=4:layout=0_0|w0_0|0_h0|w0_h0"
+  ffmpeg -y -loglevel error "${inputs[@]}" -filter_complex \
+    "$stack,scale=$STRIP_WIDTH:-2:flags=lanczos,split[a][b];[a]palettegen=max_colors=256[p];[b][p]paletteuse=dither=sierra2_4a" \
+    -frames:v 1 "$STRIP_FILE"
+  echo "render.sh: $STRIP_FILE (frames $STRIP)"
 fi

@@ -15,7 +15,8 @@ packages=(
   libassimp-dev libopenvdb-dev libtbb-dev libboost-iostreams-dev   # meshes, level sets (geometry/)
   paraview python3-paraview xvfb xauth ffmpeg                        # pictures: scripts/render.sh
   libgtest-dev
-  python3 python3-numpy python3-h5py python3-matplotlib
+  python3 python3-numpy python3-h5py python3-matplotlib python3-pil   # tests, plots
+  python3-scipy                                                      # scripts/measure_scenes.py
 )
 
 missing=()
