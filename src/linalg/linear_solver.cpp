@@ -51,7 +51,10 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
                  "grid lines: the most nodes in one block (longer runs are cut into near-equal pieces)")
         .real(&S::line_damping, "Line damping", 1.5, Range::open_closed(0.0, 2.0),
               "grid lines: the block Jacobi damping is this over the largest eigenvalue of (blocks⁻¹ H), "
-              "estimated by power iterations at each set-up (< 2 for a convergent smoother)");
+              "estimated by power iterations at each set-up (< 2 for a convergent smoother)")
+        .integer(&S::max_ranks, "Ranks", 0, Range::at_least(0),
+                 "the most ranks this configuration runs on (0: any; 1 for preconditioners that only work on "
+                 "one rank): a run on more is bad input");
     return table;
   }();
   return t;
@@ -60,10 +63,6 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
 namespace {
 constexpr const char* krylov_sublist = "Krylov parameters";
 constexpr const char* preconditioner_sublist = "Preconditioner parameters";
-
-bool is_block_relaxation(const std::string& type) {
-  return type == "BLOCK_RELAXATION" || type == "BLOCK RELAXATION" || type == "BLOCKRELAXATION";
-}
 
 // Smoother blocks = grid lines: the fine level's smoother must be a block relaxation whose blocks
 // viscompm can give (partitioner "user"); viscompm sets the blocks and the damping itself.
@@ -168,6 +167,13 @@ SolverConfiguration SolverConfiguration::from_xml(const std::string& xml, const 
 }
 
 const std::string& SolverConfiguration::label() const { return impl_->settings.label; }
+void SolverConfiguration::check_rank_count(int ranks) const {
+  const int most = impl_->settings.max_ranks;
+  if (most > 0 && ranks > most)
+    throw InputError(origin() + ": parameter 'Ranks': this solver file runs on at most " + std::to_string(most) +
+                     (most == 1 ? " rank (one rank only)" : " ranks") + ", the run has " + std::to_string(ranks));
+}
+
 const std::string& SolverConfiguration::origin() const { return impl_->origin; }
 bool SolverConfiguration::matrix_free() const { return impl_->settings.operator_form == OperatorForm::matrix_free; }
 

@@ -201,6 +201,7 @@ MatrixMarketSolve MatrixMarketProblem::solve(const SolverConfiguration& config) 
   if (config.impl().settings.operator_form == OperatorForm::matrix_free)
     throw InputError(config.origin() + ": a matrix-free configuration cannot solve a MatrixMarket system");
   const auto& A = impl_->A;
+  config.check_rank_count(A->getComm()->getSize());
   multivector_type x(A->getDomainMap(), 1), b(*impl_->b, Teuchos::Copy);
   FixedMatrix H(A);
   auto preconditioner = make_preconditioner(config);

@@ -12,6 +12,7 @@
 #include "preconditioner.hpp"
 
 #include <Ifpack2_BlockRelaxation.hpp>
+#include <Ifpack2_Chebyshev.hpp>
 #include <iostream>
 #include <streambuf>
 #include <Teuchos_ScalarTraits.hpp>
@@ -59,8 +60,9 @@ parts_type grid_line_parts(const SystemGrid& grid, int max_nodes) {
 // damping from the matrix it smooths.
 class GridLines {
  public:
-  /// The runs of owned grid nodes along each axis, as blocks of dofs (3 per node, consecutive).
-  static parts_type parts(const SystemGrid& grid, int max_nodes) {
+  /// The smoother's Ifpack2 list: the configured one with the blocks of `grid` — the runs of owned
+  /// grid nodes along each axis, as blocks of dofs (3 per node, consecutive).
+  const Teuchos::ParameterList& prepare(const Teuchos::ParameterList& configured, const SystemGrid& grid, int max_nodes) {
     parts_type parts;
     for (const auto& line : grid::node_lines(grid.owned_nodes, max_nodes)) {
       Teuchos::ArrayRCP<local_ordinal_type> dofs(3 * line.size());
@@ -68,24 +70,28 @@ class GridLines {
         for (int d = 0; d < 3; ++d) dofs[3 * k + d] = static_cast<local_ordinal_type>(3 * line[k] + d);
       parts.push_back(dofs);
     }
-    return parts;
+    list_ = configured;
+    list_.set("partitioner: parts", parts);
+    eigenvector_ = Teuchos::null;
+    return list_;
   }
 
+  const Teuchos::ParameterList& list() const { return list_; }
+
   /// Additive (Jacobi) blocks need a damping below 2/λmax(S A), S one undamped sweep of block
-  /// solves: `smoother` (set up on A) gets Line damping / λmax, λmax by power iterations that
-  /// start from the last estimate's vector while the pattern stays (the same start on any rank
-  /// count at first). Gauss-Seidel over the blocks needs none.
-  void set_damping(ifpack2_preconditioner_type& smoother, const crs_matrix_type& A, const SolverSettings& settings,
-                   const Teuchos::ParameterList& configured, bool pattern_changed) {
-    if (configured.isType<std::string>("relaxation: type") && configured.get<std::string>("relaxation: type") != "Jacobi")
-      return;
-    Teuchos::ParameterList one_sweep;
+  /// solves: `smoother` (set up on A with prepare()'s list) gets Line damping / λmax, λmax by power
+  /// iterations that start from the last estimate's vector while the blocks stay (the same start
+  /// on any rank count at first). Gauss-Seidel over the blocks needs none. Ifpack2 replaces its
+  /// whole list on setParameters: every call passes the complete one.
+  void set_damping(ifpack2_preconditioner_type& smoother, const crs_matrix_type& A, const SolverSettings& settings) {
+    if (list_.isType<std::string>("relaxation: type") && list_.get<std::string>("relaxation: type") != "Jacobi") return;
+    Teuchos::ParameterList one_sweep = list_;
     one_sweep.set("relaxation: damping factor", 1.0);
     one_sweep.set("relaxation: sweeps", 1);
     one_sweep.set("relaxation: zero starting solution", true);
     smoother.setParameters(one_sweep);
     int iterations = 5;
-    if (pattern_changed || eigenvector_.is_null()) {
+    if (eigenvector_.is_null()) {
       eigenvector_ = Teuchos::rcp(new vector_type(A.getDomainMap()));
       auto view = eigenvector_->getLocalViewHost(Tpetra::Access::OverwriteAll);
       const auto& map = *A.getDomainMap();
@@ -102,21 +108,14 @@ class GridLines {
       smoother.apply(y, x);
       lambda = x.norm2();
     }
-    Teuchos::ParameterList configured_sweeps;
-    configured_sweeps.set("relaxation: damping factor", settings.line_damping / lambda);
-    configured_sweeps.set("relaxation: sweeps",
-                          configured.isType<int>("relaxation: sweeps") ? configured.get<int>("relaxation: sweeps") : 1);
-    configured_sweeps.set("relaxation: zero starting solution",
-                          !configured.isType<bool>("relaxation: zero starting solution") ||
-                              configured.get<bool>("relaxation: zero starting solution"));
-    smoother.setParameters(configured_sweeps);
-    damping_ = settings.line_damping / lambda;
+    Teuchos::ParameterList damped = list_;
+    damped.set("relaxation: damping factor", settings.line_damping / lambda);
+    smoother.setParameters(damped);
   }
-  double damping() const { return damping_; }
 
  private:
-  Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate, on the current pattern
-  double damping_ = 0.0;
+  Teuchos::ParameterList list_;            // the smoother's complete Ifpack2 list
+  Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate, for these blocks
 };
 
 // MueLu 13.2 prints a block-relaxation smoother's parameter list to std::cout whenever it sets one
@@ -192,13 +191,15 @@ class Ifpack2Preconditioner : public Preconditioner {
       // 3×3 point-block relaxation: one block per node (a node's three dofs are consecutive).
       if (settings.ifpack2_type == "BLOCK_RELAXATION" && !grid_lines && !params.isParameter("partitioner: local parts"))
         params.set("partitioner: local parts", static_cast<local_ordinal_type>(A->getNodeNumRows() / 3));
-      if (grid_lines) params.set("partitioner: parts", GridLines::parts(*grid_of(modes), settings.line_length));
-      prec_->setParameters(params);
+      prec_->setParameters(grid_lines ? lines_.prepare(params, *grid_of(modes), settings.line_length) : params);
+      prec_->initialize();
+    } else if (is_block_relaxation(settings.ifpack2_type)) {
+      // Ifpack2 13.2's block containers copy only the nonzero entries of a block when they are
+      // computed again, over the factors of the last values: initialize() zeroes them first.
       prec_->initialize();
     }
     prec_->compute();  // new values, same pattern
-    if (grid_lines)
-      lines_.set_damping(*prec_, *A, settings, *config_.impl().preconditioner_parameters, pattern_changed);
+    if (grid_lines) lines_.set_damping(*prec_, *A, settings);
   }
   Teuchos::RCP<operator_type> op() const override { return prec_; }
 
@@ -249,26 +250,42 @@ Teuchos::RCP<crs_matrix_type> make_prolongator(const parallel::CoarseLevel& c, c
 class MueLuPreconditioner : public Preconditioner {
  public:
   explicit MueLuPreconditioner(const SolverConfiguration& config) : config_(config) {}
+  // New values on the same pattern refresh what depends on values and keep what does not:
+  // geometric prolongators are kept and everything else is built anew (Galerkin products,
+  // smoothers with fresh Chebyshev bounds, the coarse solve); an algebraic hierarchy whose file asks
+  // for MueLu's reuse is reused by MueLu, its Chebyshev bounds re-estimated (MueLu 13.2 keeps the
+  // first matrix's), or built anew when MueLu cannot reuse it (it throws when what it kept no
+  // longer fits). The fine level's grid-line blocks get a fresh damping either way.
   void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace& modes) override {
     const Teuchos::RCP<crs_matrix_type> A = H.matrix();
-    const bool reuse = config_.impl().preconditioner_parameters->get<std::string>("reuse: type", "none") != "none";
-    if (!pattern_changed && reuse && !prec_.is_null()) {
-      MueLu::ReuseTpetraPreconditioner(A, *prec_);
-      return;
+    const SolverSettings& settings = config_.impl().settings;
+    const bool grid_lines = settings.smoother_blocks == SmootherBlocks::grid_lines;
+    if (pattern_changed) geometric_levels_.clear();
+    if (!pattern_changed && !prec_.is_null() && settings.prolongation == Prolongation::algebraic && muelu_reuse()) {
+      try {
+        const SilencedStdout quiet;
+        MueLu::ReuseTpetraPreconditioner(A, *prec_);
+        refresh_chebyshev_bounds();
+        if (grid_lines) set_fine_smoother_damping(*A);
+        return;
+      } catch (const std::exception&) {
+        prec_ = Teuchos::null;  // built anew below
+      }
     }
     Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
     if (!params.isParameter("number of equations")) params.set("number of equations", 3);
-    const SolverSettings& settings = config_.impl().settings;
-    const bool grid_lines = settings.smoother_blocks == SmootherBlocks::grid_lines;
-    if (grid_lines)
-      params.sublist("level 0").sublist("smoother: params").set("partitioner: parts",
-                                                                 GridLines::parts(*grid_of(modes), settings.line_length));
+    if (grid_lines) {
+      Teuchos::ParameterList& smoother = params.sublist("level 0").sublist("smoother: params");
+      smoother = pattern_changed || lines_.list().numParams() == 0
+                     ? lines_.prepare(smoother, *grid_of(modes), settings.line_length)
+                     : lines_.list();
+    }
     {
       const SilencedStdout quiet;
       if (settings.prolongation == Prolongation::algebraic) setup_algebraic(A, params, modes);
       else setup_geometric(A, params, modes);
     }
-    if (grid_lines) set_fine_smoother_damping(*A, pattern_changed);
+    if (grid_lines) set_fine_smoother_damping(*A);
   }
   Teuchos::RCP<operator_type> op() const override { return prec_; }
   Teuchos::RCP<const crs_matrix_type> level_matrix(int level) const override {
@@ -323,16 +340,21 @@ class MueLuPreconditioner : public Preconditioner {
                                                                        : parallel::Prolongation::quadratic_bspline;
     settings.max_levels = params.get<int>("max levels", 10);
     settings.coarsest_nodes = config_.impl().settings.coarsest_nodes;
-    const auto levels = parallel::build_grid_hierarchy(communicator, modes.grid->dimensions, modes.grid->owned_nodes,
-                                                       modes.grid->owner, settings);
-    Teuchos::RCP<const map_type> fine = A->getRowMap();
-    for (std::size_t l = 0; l < levels.size(); ++l) {
-      Teuchos::RCP<const map_type> coarse;
-      const auto P = make_prolongator(levels[l], fine, coarse);
-      params.sublist("level " + std::to_string(l + 1)).set("P", MueLu::TpetraCrs_To_XpetraMatrix(P));
-      fine = coarse;
+    // The prolongators depend on the grid only: built once per pattern.
+    if (geometric_levels_.empty()) {
+      const auto levels = parallel::build_grid_hierarchy(communicator, modes.grid->dimensions, modes.grid->owned_nodes,
+                                                         modes.grid->owner, settings);
+      Teuchos::RCP<const map_type> fine = A->getRowMap();
+      for (const auto& level : levels) {
+        Teuchos::RCP<const map_type> coarse;
+        geometric_levels_.push_back(MueLu::TpetraCrs_To_XpetraMatrix(make_prolongator(level, fine, coarse)));
+        fine = coarse;
+      }
     }
-    params.set("max levels", static_cast<int>(levels.size()) + 1);
+    for (std::size_t l = 0; l < geometric_levels_.size(); ++l)
+      params.sublist("level " + std::to_string(l + 1)).set("P", geometric_levels_[l]);
+    params.remove("reuse: type", false);  // what reuse can keep (the P) is kept above
+    params.set("max levels", static_cast<int>(geometric_levels_.size()) + 1);
     params.set("coarse: max size", 1);
     Teuchos::ParameterList serializable, non_serializable;
     MueLu::ExtractNonSerializableData(params, serializable, non_serializable);
@@ -345,28 +367,51 @@ class MueLuPreconditioner : public Preconditioner {
     prec_ = Teuchos::rcp(new muelu_operator_type(hierarchy));
   }
 
-  // The fine level's block relaxation (pre- and post-smoother, one object or two) gets its damping.
-  void set_fine_smoother_damping(const crs_matrix_type& A, bool pattern_changed) {
-    const auto level = prec_->GetHierarchy()->GetLevel(0);
-    const Teuchos::ParameterList& configured =
-        config_.impl().preconditioner_parameters->sublist("level 0").sublist("smoother: params");
-    Teuchos::RCP<muelu_ifpack2_smoother_type> previous;
+  bool muelu_reuse() const {
+    const auto& params = *config_.impl().preconditioner_parameters;
+    return params.isType<std::string>("reuse: type") && params.get<std::string>("reuse: type") != "none";
+  }
+
+  // The Ifpack2 smoothers of a level (pre and post, one object or two; MueLu's interpreter wraps
+  // them in a TrilinosSmoother).
+  std::vector<Teuchos::RCP<muelu_ifpack2_smoother_type>> level_smoothers(int l) const {
+    std::vector<Teuchos::RCP<muelu_ifpack2_smoother_type>> smoothers;
+    const auto level = prec_->GetHierarchy()->GetLevel(l);
     for (const char* which : {"PreSmoother", "PostSmoother"}) {
       if (!level->IsAvailable(which)) continue;
-      // MueLu's interpreter wraps its Ifpack2 smoothers in a TrilinosSmoother.
       const auto held = level->template Get<Teuchos::RCP<muelu_smoother_type>>(which);
       auto smoother = Teuchos::rcp_dynamic_cast<muelu_ifpack2_smoother_type>(held);
       if (const auto wrapper = Teuchos::rcp_dynamic_cast<muelu_trilinos_smoother_type>(held); !wrapper.is_null())
         smoother = Teuchos::rcp_dynamic_cast<muelu_ifpack2_smoother_type>(wrapper->getSmoother());
-      if (smoother.is_null() || smoother == previous) continue;
-      lines_.set_damping(*smoother->getPreconditioner(), A, config_.impl().settings, configured,
-                         pattern_changed || !previous.is_null());
-      previous = smoother;
+      if (!smoother.is_null() && (smoothers.empty() || smoothers.back() != smoother)) smoothers.push_back(smoother);
     }
+    return smoothers;
+  }
+
+  // MueLu 13.2 hands a reused Chebyshev smoother the largest eigenvalue it estimated for the first
+  // matrix (cached in the smoother's list): without it, Ifpack2 estimates it for the current one.
+  void refresh_chebyshev_bounds() {
+    for (int l = 0; l < prec_->GetHierarchy()->GetNumLevels(); ++l)
+      for (const auto& smoother : level_smoothers(l)) {
+        auto chebyshev = Teuchos::rcp_dynamic_cast<Ifpack2::Chebyshev<row_matrix_type>>(smoother->getPreconditioner());
+        if (chebyshev.is_null()) continue;
+        Teuchos::ParameterList& list = const_cast<Teuchos::ParameterList&>(smoother->GetParameterList());
+        list.remove("chebyshev: max eigenvalue", false);
+        Teuchos::ParameterList fresh = list;
+        chebyshev->setParameters(fresh);
+        chebyshev->compute();
+      }
+  }
+
+  // The fine level's block relaxation (pre- and post-smoother, one object or two) gets its damping.
+  void set_fine_smoother_damping(const crs_matrix_type& A) {
+    for (const auto& smoother : level_smoothers(0))
+      lines_.set_damping(*smoother->getPreconditioner(), A, config_.impl().settings);
   }
 
   SolverConfiguration config_;
   Teuchos::RCP<muelu_operator_type> prec_;
+  std::vector<Teuchos::RCP<xpetra_matrix_type>> geometric_levels_;  // P of levels 1, 2, ... (this pattern)
   GridLines lines_;
 };
 }  // namespace

@@ -30,9 +30,15 @@ struct SolverSettings {
   SmootherBlocks smoother_blocks = SmootherBlocks::library;
   int line_length = 16;
   double line_damping = 1.5;
+  int max_ranks = 0;
 
   static const ParameterTable<SolverSettings>& table();
 };
+
+/// Ifpack2's names of its block relaxation.
+inline bool is_block_relaxation(const std::string& type) {
+  return type == "BLOCK_RELAXATION" || type == "BLOCK RELAXATION" || type == "BLOCKRELAXATION";
+}
 
 struct SolverConfiguration::Impl {
   std::string origin;

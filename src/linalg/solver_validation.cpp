@@ -218,8 +218,21 @@ void validate_ifpack2_parameters(const std::string& type, const Teuchos::Paramet
   }
   Teuchos::RCP<const Teuchos::ParameterList> valid;
   if (auto* r = dynamic_cast<Ifpack2::Relaxation<row_matrix_type>*>(prec.get())) valid = r->getValidParameters();
-  if (auto* s = dynamic_cast<Ifpack2::AdditiveSchwarz<row_matrix_type>*>(prec.get())) valid = s->getValidParameters();
-  if (!valid.is_null()) check_against(given, *valid, origin, path);
+  if (auto* s = dynamic_cast<Ifpack2::AdditiveSchwarz<row_matrix_type>*>(prec.get())) {
+    // AdditiveSchwarz reads its inner solver's names and list without listing them as valid.
+    auto with_inner = Teuchos::rcp(new Teuchos::ParameterList(*s->getValidParameters()));
+    const Teuchos::ParameterList& names = ifpack2_names();
+    for (const char* name : {"inner preconditioner name", "subdomain solver name", "schwarz: inner preconditioner name",
+                             "schwarz: subdomain solver name", "inner preconditioner parameters",
+                             "subdomain solver parameters", "schwarz: inner preconditioner parameters",
+                             "schwarz: subdomain solver parameters"})
+      if (!with_inner->isParameter(name)) with_inner->setEntry(name, names.getEntry(name));
+    valid = with_inner;
+  }
+  if (!valid.is_null()) check_against(given, *valid, origin, path, {"inner preconditioner parameters",
+                                                                    "subdomain solver parameters",
+                                                                    "schwarz: inner preconditioner parameters",
+                                                                    "schwarz: subdomain solver parameters"});
   try {
     prec->setParameters(given);
   } catch (const std::exception& e) {

@@ -201,10 +201,14 @@ bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVector
     }
     rules_.demand_fresh();  // the next attempt sets up its own preconditioner
   }
-  if (step.report.failure.empty())
+  if (step.report.failure.empty()) {
+    const linalg::LinearSolveReport& last = step.report.linear_solves.back();
     step.report.failure = "no direction with sufficient decrease (the last: " +
-                          std::string(step.report.linear_solves.back().converged ? "line search failed"
-                                                                                 : "linear solve failed") + ")";
+                          std::string(last.converged ? "line search failed"
+                                                     : "linear solve failed" + (last.failure.empty() ? std::string()
+                                                                                                      : ": " + last.failure)) +
+                          ")";
+  }
   return false;
 }
 
@@ -231,7 +235,7 @@ bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, 
     solve.failure = cg.failure;
   }
   report.projected_solves += attempt.project;
-  rules_.solved(solve.iterations);
+  rules_.solved(solve.iterations, solve.tolerance);
 
   step.potential.constraints().project(dv);
   const double slope = -owned_dot(rhs, dv, step.potential.layout().owned_count, comm_);  // ∇E·dv

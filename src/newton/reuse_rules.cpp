@@ -1,5 +1,8 @@
 #include "viscompm/newton/reuse_rules.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace viscompm::newton {
 
 void ReuseRules::begin_solve(double dt, std::uint64_t pattern, bool matrix_free) {
@@ -53,13 +56,16 @@ void ReuseRules::preconditioned() {
   preconditioned_this_step_ = true;
 }
 
-void ReuseRules::solved(int iterations) {
-  // The refresh rule: CG slowing down means the kept H or preconditioner has gone stale.
-  if (hessian_baseline_cg_ < 0) hessian_baseline_cg_ = iterations;
-  else if (iterations > settings_.refresh_growth * hessian_baseline_cg_) refresh_hessian_ = true;
-  if (preconditioner_baseline_cg_ < 0) preconditioner_baseline_cg_ = iterations;
+void ReuseRules::solved(int iterations, double tolerance) {
+  // The refresh rule: CG slowing down means the kept H or preconditioner has gone stale. Solves
+  // to different tolerances (inexact Newton) are compared by iterations per decade of reduction.
+  const double decades = std::max(1.0, -std::log10(std::max(tolerance, 1e-300)));
+  const double rate = iterations / decades;
+  if (hessian_baseline_cg_ < 0) hessian_baseline_cg_ = rate;
+  else if (rate > settings_.refresh_growth * hessian_baseline_cg_) refresh_hessian_ = true;
+  if (preconditioner_baseline_cg_ < 0) preconditioner_baseline_cg_ = rate;
   else if (settings_.preconditioner_update == PreconditionerUpdate::lagged &&
-           iterations > settings_.refresh_growth * preconditioner_baseline_cg_)
+           rate > settings_.refresh_growth * preconditioner_baseline_cg_)
     refresh_preconditioner_ = true;
 }
 

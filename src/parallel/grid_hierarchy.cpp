@@ -144,7 +144,11 @@ std::vector<CoarseLevel> build_grid_hierarchy(const Communicator& comm, const In
   int origin = 0;
   std::vector<Int3> fine = owned_fine;
   std::int64_t count = comm.sum(static_cast<std::int64_t>(fine.size()));
-  for (int level = 1; level < settings.max_levels && count > settings.coarsest_nodes; ++level) {
+  // Down to Coarsest nodes, and at least one coarse level above the smallest systems: a lone
+  // fine level would make the "multigrid" its smoother alone.
+  for (int level = 1; level < settings.max_levels &&
+                      (count > settings.coarsest_nodes || (levels.empty() && count > settings.always_coarsen_above));
+       ++level) {
     levels.push_back(coarsen(comm, dims, origin, fine, level, level0_last, owner, settings.prolongation));
     const CoarseLevel& c = levels.back();
     // Coarsening must make progress (a level of one node per rank cannot shrink further).

@@ -23,7 +23,7 @@ std::pair<bool, bool> iterate(ReuseRules& rules, int cg = 10, double alpha = 1.0
   if (assemble) rules.assembled(false);
   const bool setup = rules.setup_now();
   if (setup) rules.preconditioned();
-  rules.solved(cg);
+  rules.solved(cg, 1e-6);
   rules.line_search_step(alpha);
   return {assemble, setup};
 }
@@ -90,6 +90,22 @@ TEST(ReuseRules, ALaggedPreconditionerIsRefreshedWhenCgSlowsDown) {
   rules.begin_solve(0.01, 1, false);
   EXPECT_EQ(iterate(rules, 16), std::make_pair(true, false));  // 16 > 1.5 × 10: refresh next
   EXPECT_EQ(iterate(rules, 10), std::make_pair(true, true));
+}
+
+TEST(ReuseRules, SolvesToDifferentTolerancesAreComparedPerDecadeOfReduction) {
+  ReuseRules rules(strategy(HessianUpdate::every_iteration, PreconditionerUpdate::lagged));
+  rules.begin_solve(0.01, 1, false);
+  rules.assembled(false);
+  rules.preconditioned();
+  rules.solved(10, 0.1);  // 10 iterations per decade
+  rules.assembled(false);
+  EXPECT_FALSE(rules.setup_now());
+  rules.solved(50, 1e-6);  // 8.3 per decade: as fast
+  rules.assembled(false);
+  EXPECT_FALSE(rules.setup_now());
+  rules.solved(40, 1e-2);  // 20 per decade: slower than 1.5 × 10
+  rules.assembled(false);
+  EXPECT_TRUE(rules.setup_now());
 }
 
 TEST(ReuseRules, ADemandForFreshMatricesAndForgettingRebuildBoth) {

@@ -30,13 +30,14 @@ std::vector<Int3> blob_nodes(const grid::GridGeometry& g, const parallel::Decomp
   return nodes;
 }
 
-std::vector<parallel::CoarseLevel> hierarchy(const parallel::Communicator& comm, parallel::Prolongation kind) {
+std::vector<parallel::CoarseLevel> hierarchy(const parallel::Communicator& comm, parallel::Prolongation kind,
+                                             std::int64_t coarsest_nodes = 20) {
   grid::GridGeometry g;
   g.cells = Int3(28, 25, 23);
   const parallel::BlockDecomposition d(g, comm.size());
   parallel::HierarchySettings settings;
   settings.prolongation = kind;
-  settings.coarsest_nodes = 20;
+  settings.coarsest_nodes = coarsest_nodes;
   return parallel::build_grid_hierarchy(comm, g.nodes(), blob_nodes(g, d, comm.rank()),
                                         [&d](const Int3& ijk) { return d.owner_of_node(ijk); }, settings);
 }
@@ -48,6 +49,20 @@ Int3 index_of(NodeId id, const Int3& dims) {
 }  // namespace
 
 class GridHierarchyTest : public ::testing::TestWithParam<parallel::Prolongation> {};
+
+TEST_P(GridHierarchyTest, ASystemSmallerThanTheCoarsestLevelStillGetsOneCoarseLevel) {
+  // ~3 400 nodes under a Coarsest nodes of 10⁶: one coarse level, at least halving the nodes (the
+  // B-spline level keeps a ring of parents around the blob), and no more.
+  const parallel::Communicator comm(MPI_COMM_WORLD);
+  grid::GridGeometry g;
+  g.cells = Int3(28, 25, 23);
+  const parallel::BlockDecomposition d(g, comm.size());
+  const auto fine = comm.sum(static_cast<std::int64_t>(blob_nodes(g, d, comm.rank()).size()));
+  const auto levels = hierarchy(comm, GetParam(), 1000000);
+  ASSERT_EQ(levels.size(), 1u);
+  EXPECT_LT(2 * levels[0].global_count, fine);
+  EXPECT_GT(levels[0].global_count, 1);
+}
 
 TEST_P(GridHierarchyTest, ProlongationReproducesLinearFieldsAndConstants) {
   const parallel::Communicator comm(MPI_COMM_WORLD);

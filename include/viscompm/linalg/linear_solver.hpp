@@ -34,6 +34,9 @@ class SolverConfiguration {
   const std::string& origin() const;
   /// True for the matrix-free Hessian (Operator = matrix-free).
   bool matrix_free() const;
+  /// Throws InputError (naming the file and 'Ranks') when a run on `ranks` ranks is more than the
+  /// file supports.
+  void check_rank_count(int ranks) const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }

@@ -35,8 +35,9 @@ class ReuseRules {
   void assembled(bool projected);
   /// The preconditioner was set up for the current H.
   void preconditioned();
-  /// A linear solve took `iterations`: the growth rule.
-  void solved(int iterations);
+  /// A linear solve to the relative residual `tolerance` took `iterations`: the growth rule, on
+  /// iterations per decade of reduction (tolerance 0.1 or looser counts as one decade).
+  void solved(int iterations, double tolerance);
   /// The line search accepted step length `alpha` (< 1: the refresh rule).
   void line_search_step(double alpha);
   /// The next direction needs a fresh H and a fresh preconditioner (a kept one failed).
@@ -55,8 +56,8 @@ class ReuseRules {
   bool preconditioner_matches_hessian_ = false;
   double preconditioner_dt_ = 0.0;
   std::uint64_t preconditioner_pattern_ = 0;
-  int hessian_baseline_cg_ = -1;         // CG iterations of the first solve after the last assembly
-  int preconditioner_baseline_cg_ = -1;  // ... after the last preconditioner set-up
+  double hessian_baseline_cg_ = -1;         // CG iterations per decade of the first solve after the last assembly
+  double preconditioner_baseline_cg_ = -1;  // ... after the last preconditioner set-up
   bool refresh_hessian_ = false;
   bool refresh_preconditioner_ = false;
   // This solve.

@@ -49,6 +49,7 @@ struct HierarchySettings {
   Prolongation prolongation = Prolongation::trilinear;
   int max_levels = 10;                  ///< levels including the finest
   std::int64_t coarsest_nodes = 2000;   ///< stop once a level has at most this many nodes
+  std::int64_t always_coarsen_above = 64;  ///< but coarsen once at least when the fine level has more
 };
 
 /// The coarse levels below a fine level whose owned nodes are `owned_fine` (grid indices of
