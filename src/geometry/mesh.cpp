@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include "viscompm/core/error.hpp"
 
@@ -49,6 +50,14 @@ TriangleMesh read_mesh(const std::string& file) {
     }
   }
   if (mesh.triangles.empty()) throw InputError(file + ": the mesh has no triangles");
+  // A non-finite corner would merge with any other below (map keys compare false with NaN) and
+  // poison every distance of the level set.
+  for (const Vec3& v : mesh.vertices)
+    if (!v.allFinite()) {
+      std::ostringstream reason;
+      reason << file << ": a vertex (" << v.transpose() << ") is not finite";
+      throw InputError(reason.str());
+    }
   // Meshes of several parts (and STL files) may repeat positions across parts: merge exact
   // duplicates so that closedness is judged on the surface, not on the file's layout.
   std::map<std::array<double, 3>, int> unique;
