@@ -52,7 +52,7 @@ int run_simulation_program(int argc, char** argv) {
       return exit_success;
     }
     const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
-    const linalg::SolverConfiguration solver = linalg::SolverConfiguration::read(scene.solver_file);
+    const linalg::SolverConfiguration solver = scene::solver_configuration(scene);
     simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);
     if (summary.stop_signal != 0) {

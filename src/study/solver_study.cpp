@@ -11,7 +11,7 @@
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/matrix_market.hpp"
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 #include "viscompm/simulation/simulation.hpp"
 
 namespace viscompm::study {
@@ -134,12 +134,12 @@ void log_row(std::ostream& log, const Row& row) {
 void study_scene_systems(const StudySettings& settings, const std::string& study_file,
                          const std::vector<linalg::SolverConfiguration>& configs, const parallel::Communicator& comm,
                          Writer& writer, std::ostream& log) {
-  const scene::SceneConfig base = scene::read_scene(relative_to(study_file, settings.scene));
   for (double h : settings.cell_sizes) {
-    scene::SceneConfig scene = base;
-    scene.grid.cell_size = h;
+    // The cell size as an override, so that what derives from it (meshes' voxels, nozzles) follows.
+    const scene::SceneConfig scene =
+        scene::read_scene(relative_to(study_file, settings.scene), {{"Grid/Cell size", number(h)}});
     // Advance with the scene's own solver, then take the step's Newton system at several Δt.
-    simulation::Simulation sim(scene, linalg::SolverConfiguration::read(scene.solver_file), comm);
+    simulation::Simulation sim(scene, scene::solver_configuration(scene), comm);
     if (settings.time > 0.0) {
       simulation::RunSummary summary;
       sim.advance_to(settings.time, summary);
@@ -155,7 +155,7 @@ void study_scene_systems(const StudySettings& settings, const std::string& study
     for (double step : settings.time_steps) {
       const auto objective = integrator.build_objective(sim.particles(), sim.time(), seconds(step));
       Row row;
-      row.problem = base.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
+      row.problem = scene.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
       row.resolution = h;
       NodeVectorField rhs;
       if (!integrator.first_right_hand_side(*objective, rhs)) {
@@ -298,17 +298,17 @@ int study_steps(const StudySettings& settings, const std::string& study_file, co
 }  // namespace
 
 StudySettings read_study(const std::string& file, const std::vector<scene::Override>& overrides) {
-  auto list = scene::read_xml_file(file);
+  auto list = params::read_xml_file(file);
   const auto& specs = StudySettings::table().specs();
   for (const auto& o : overrides) {
     const ParameterSpec* spec = nullptr;
     for (const auto& s : specs)
       if (s.name == o.path) spec = &s;
     if (spec == nullptr) throw InputError(file + ": --set '" + o.path + "': unknown parameter");
-    scene::set_entry(*list, o.path, scene::parse_value(*spec, o.value));
+    params::set_entry(*list, o.path, params::parse_value(*spec, o.value));
   }
   StudySettings settings =
-      StudySettings::table().parse(scene::read_parameters(*list, specs, file, "", {"Configurations"}));
+      StudySettings::table().parse(params::read_parameters(*list, specs, file, "", {"Configurations"}));
   if (settings.scene.empty() && settings.matrix_market_files.empty())
     throw InputError(file + ": parameter 'Scene': a study needs a scene or Matrix Market files");
   if (settings.mode == "steps") {
@@ -327,7 +327,7 @@ StudySettings read_study(const std::string& file, const std::vector<scene::Overr
         const std::string& name = configurations.name(it);
         const std::string path = "Configurations/" + name;
         if (!configurations.isSublist(name)) throw InputError(file + ": parameter '" + path + "': expected a sublist");
-        const auto c = ConfigurationSettings::table().parse(scene::read_parameters(
+        const auto c = ConfigurationSettings::table().parse(params::read_parameters(
             configurations.sublist(name), ConfigurationSettings::table().specs(), file, path));
         if (c.solver.empty()) throw InputError(file + ": parameter '" + path + "/Solver': give a solver file");
         settings.configurations.push_back({name, relative_to(file, c.solver), c.newton});

@@ -14,6 +14,12 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The one line of bad input at a parameter: "FILE: parameter 'PATH': REASON" (PATH is the
+/// parameter's sublist path, e.g. "Bodies/sponge/Material"). Every such message is made here.
+inline InputError parameter_error(const std::string& file, const std::string& path, const std::string& reason) {
+  return InputError(file + ": parameter '" + path + "': " + reason);
+}
+
 /// The simulation cannot continue (a step failed at the smallest time step, a write failed, ...).
 /// Frames and checkpoints already written stay intact. Exit code 3.
 class SimulationError : public std::runtime_error {
