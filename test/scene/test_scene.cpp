@@ -227,6 +227,35 @@ TEST(CommandLine, AcceptsTheContractForms) {
   EXPECT_THROW(scene::parse_command_line(1, none, scene::ProgramOptions{"viscompm", "test"}), InputError);
 }
 
+// Issue 17, class 6: an option given twice, or a parameter set twice, would silently keep the
+// last; a --frames that is not a number is reported as --frames.
+TEST(CommandLine, RepeatedOptionsAndParametersSetTwiceAreRejected) {
+  auto error = [](std::vector<const char*> argv) {
+    try {
+      scene::parse_command_line(static_cast<int>(argv.size()), argv.data(), scene::ProgramOptions{"viscompm", "test"});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string m = error({"viscompm", "scene.xml", "--solver", "a.xml", "--solver=b.xml"});
+  EXPECT_NE(m.find("--solver is given more than once"), std::string::npos) << m;
+  for (const char* option : {"--output", "--frames", "--restart"}) {
+    m = error({"viscompm", "scene.xml", option, "1", option, "2"});
+    EXPECT_NE(m.find(std::string(option) + " is given more than once"), std::string::npos) << m;
+  }
+  m = error({"viscompm", "scene.xml", "--set", "Grid/Cell size=0.1", "--set", "Grid/Cell size=0.2"});
+  EXPECT_NE(m.find("'Grid/Cell size' is set twice (--set and --set)"), std::string::npos) << m;
+  m = error({"viscompm", "scene.xml", "--frames", "2", "--set", "Simulation/Frames=3"});
+  EXPECT_NE(m.find("'Simulation/Frames' is set twice (--set and --frames)"), std::string::npos) << m;
+  for (const char* frames : {"abc", "-1", "2x", "", "99999999999"}) {
+    m = error({"viscompm", "scene.xml", "--frames", frames});
+    EXPECT_NE(m.find("option --frames: '" + std::string(frames) + "' is not a number of frames"), std::string::npos) << m;
+    EXPECT_EQ(m.find("Simulation/Frames"), std::string::npos) << m;
+  }
+  EXPECT_EQ(error({"viscompm", "scene.xml", "--set", "A/B=1", "--set", "C/D=2", "--frames", "0"}), "");
+}
+
 TEST(Scene, AMissingSolverFileNamesTheSceneAndTheParameter) {
   const std::string message = read_error(default_scene, {{"Solver/File", "../solvers/no_such_solver.xml"}});
   expect_one_line_naming(message, default_scene, "Solver/File");
