@@ -110,8 +110,9 @@ double particle_surface_area(const scene::SceneConfig& scene) {
 [[noreturn]] void too_large(const scene::SceneConfig& scene, const std::string& parameter, const std::string& what,
                             double needed, double available, int ranks) {
   std::ostringstream reason;
-  reason << std::setprecision(3) << what << ", an estimated " << gib(needed) << " GiB, more than the " << gib(available)
-         << " GiB of memory of " << ranks << " rank(s)";
+  reason << std::setprecision(3) << what << ", ";
+  if (std::isfinite(needed)) reason << "an estimated " << gib(needed) << " GiB, ";
+  reason << "more than the " << gib(available) << " GiB of memory of " << ranks << " rank(s)";
   throw parameter_error(scene.file, parameter, reason.str());
 }
 }  // namespace
