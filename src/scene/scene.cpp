@@ -706,17 +706,15 @@ void nozzle_extent(const EmitterSettings& e, Vec3& lo, Vec3& hi) {
   hi = e.center + half;
 }
 
-void check_objects(const SceneConfig& scene) {
+// What needs no mesh: motions' times and keyframes, bounded bodies, emitters' velocities, times
+// and nozzles (inside the grid, off its last cells, where particles are held).
+void check_settings(const SceneConfig& scene) {
   const std::string& file = scene.file;
   const double dx = scene.grid.cell_size;
-  for (const auto& b : scene.bodies) {
-    const std::string path = "Bodies/" + b.name;
-    if (b.shape == ShapeKind::half_space) throw parameter_error(file, path + "/Shape", "a body must be bounded");
-    make_shape(b, file, path);
-  }
+  for (const auto& b : scene.bodies)
+    if (b.shape == ShapeKind::half_space) throw parameter_error(file, "Bodies/" + b.name + "/Shape", "a body must be bounded");
   for (const auto& c : scene.colliders) {
     const std::string path = "Colliders/" + c.name;
-    make_shape(c, file, path);
     check_keyframes(c, file, path);
     if (c.stop_time < c.start_time) throw parameter_error(file, path + "/Stop time", "must not precede Start time");
   }
@@ -725,7 +723,6 @@ void check_objects(const SceneConfig& scene) {
     if (e.velocity.norm() == 0.0) throw parameter_error(file, path + "/Velocity", "must be non-zero");
     if (e.stop_time <= e.start_time) throw parameter_error(file, path + "/Stop time", "must exceed Start time");
     make_shape(e, file, path);
-    // Emitted particles start inside the grid, off its last cells (where particles are held).
     Vec3 lo, hi;
     nozzle_extent(e, lo, hi);
     const Vec3 inner_lo = scene.grid.lower_corner.array() + dx, inner_hi = scene.grid.upper_corner.array() - dx;
@@ -733,7 +730,13 @@ void check_objects(const SceneConfig& scene) {
       throw parameter_error(file, path + "/Center",
                             "the nozzle reaches outside the grid (its layers must lie at least one cell inside it)");
   }
-  for (const auto& r : scene.regions) make_shape(r, file, "Regions/" + r.name);
+}
+
+// The shapes (meshes loaded) and the speeds they move at.
+void check_shapes_and_speeds(const SceneConfig& scene) {
+  for (const auto& b : scene.bodies) make_shape(b, scene.file, "Bodies/" + b.name);
+  for (const auto& c : scene.colliders) make_shape(c, scene.file, "Colliders/" + c.name);
+  for (const auto& r : scene.regions) make_shape(r, scene.file, "Regions/" + r.name);
   check_speeds(scene);
 }
 }  // namespace
@@ -752,8 +755,9 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   for (const auto& s : sections()) read_section(*root, s, reading);
   link_names(scene);
   check_grid_and_time_steps(scene);
-  derive_from_cell_size(scene);
-  check_objects(scene);
+  check_settings(scene);
+  derive_from_cell_size(scene);  // meshes: the only part of reading that may take long
+  check_shapes_and_speeds(scene);
   return scene;
 }
 
