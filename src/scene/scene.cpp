@@ -484,28 +484,34 @@ constexpr double level_set_bytes_per_voxel = 40.0;
 // OpenVDB's voxel coordinates are 32-bit integers.
 constexpr double max_voxels_across = 1073741824.0;
 
-// A mesh's level set must be one OpenVDB can build (its smallest voxel, its coordinate range)
-// and whose band fits in this machine's memory.
-void check_level_set(const geometry::TriangleMesh& mesh, double voxel, const std::string& where) {
+// A mesh's level set (of the placed mesh) must be one OpenVDB can build (its smallest voxel, its
+// coordinate range) and whose band fits in this machine's memory; the message names the
+// parameter that decides (Voxel size, or File for the default quarter cell; Scale or Center for
+// the range).
+void check_level_set(const geometry::TriangleMesh& mesh, double voxel, const ShapeSettings& s,
+                     const std::string& file, const std::string& path) {
   std::ostringstream reason;
   reason.precision(3);
   Vec3 lo, hi;
   mesh.bounding_box(lo, hi);
   const double reach = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()) / voxel;
+  const double size = (hi - lo).maxCoeff() / voxel;
   const double bytes = level_set_bytes_per_voxel * 6.0 * mesh_area(mesh) / (voxel * voxel);
   const double memory = parallel::machine_memory();
+  std::string parameter = s.voxel_size > 0.0 ? "/Voxel size" : "/File";
   if (voxel < min_voxel_size) {
     reason << "voxels of " << voxel << " m are below the smallest OpenVDB takes (" << min_voxel_size << " m)";
   } else if (reach > max_voxels_across) {
-    reason << "the mesh reaches " << reach << " voxels from the origin, more than OpenVDB can index ("
-           << max_voxels_across << ")";
+    parameter = size > max_voxels_across ? "/Scale" : "/Center";
+    reason << "the placed mesh reaches " << reach << " voxels of " << voxel
+           << " m from the origin, more than OpenVDB can index (" << max_voxels_across << ")";
   } else if (bytes > memory) {
     reason << "its level set needs about " << bytes / 1073741824.0 << " GiB (" << level_set_bytes_per_voxel
            << " bytes per voxel of its band), more than the " << memory / 1073741824.0 << " GiB of this machine";
   } else {
     return;
   }
-  throw InputError(where + reason.str());
+  throw parameter_error(file, path + parameter, reason.str());
 }
 
 // Reads the mesh of a mesh shape, places it (Scale, Center) and builds its signed distance field;
@@ -532,7 +538,7 @@ void load_mesh(ShapeSettings& s, const std::string& file, const std::string& pat
   if (must_be_closed && !geometry::is_closed(mesh))
     throw InputError(where + mesh_file + ": the mesh is not closed (every edge must join two consistently oriented triangles)");
   const double voxel = s.voxel_size > 0.0 ? s.voxel_size : 0.25 * cell_size;
-  check_level_set(mesh, voxel, file + ": parameter '" + path + (s.voxel_size > 0.0 ? "/Voxel size" : "/File") + "': ");
+  check_level_set(mesh, voxel, s, file, path);
   s.field = std::make_shared<geometry::LevelSet>(mesh, voxel);
 }
 
