@@ -31,12 +31,10 @@ io::RunState SimulationState::record(const std::string& scene_name) const {
 }
 
 materials::MaterialList make_materials(const scene::SceneConfig& scene) {
+  scene::SceneConfig linked = scene;  // a scene built in code names its models
+  scene::link_names(linked);
   materials::MaterialList list;
-  for (const auto& m : scene.materials) {
-    const materials::ModelEntry* entry = m.entry != nullptr ? m.entry : materials::find_model(m.model);
-    if (entry == nullptr) throw parameter_error(scene.file, "Materials/" + m.name + "/Model", "unknown model '" + m.model + "'");
-    list.push_back(entry->create(m.name, m.values));
-  }
+  for (const auto& m : linked.materials) list.push_back(m.entry->create(m.name, m.values));
   return list;
 }
 
