@@ -439,7 +439,9 @@ def corrupt_lines(lines, rng, what):
         parts[rng.randrange(len(parts))] = "abc"
     elif kind == "nan":
         parts[-1] = rng.choice(["nan", "inf", "1e400"])
-    elif kind == "index" and len(parts) == 3:
+    elif kind == "index":
+        if len(parts) != 3:  # a dense file's line has one value, no index
+            return lines, f"{what}: no index to corrupt", False
         parts[rng.randrange(2)] = rng.choice(["0", "-1", "99999999"])
     elif kind == "count":
         lines[size_line] = " ".join(lines[size_line].split()[:-1] + [str(int(lines[size_line].split()[-1]) + 7)])
