@@ -33,6 +33,9 @@ class Simulation {
   Simulation(const scene::SceneConfig& scene, materials::MaterialList materials,
              const linalg::SolverConfiguration& solver, const parallel::Communicator& comm,
              const std::string& restart_file = "");
+  // The stepping holds references to the scene, state and boundary held here.
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
 
   /// Writes frame 0 (unless restarted), then every remaining frame of the scene, with checkpoints
   /// as the scene asks, logging progress to `log` on rank 0. After every step the ranks agree on

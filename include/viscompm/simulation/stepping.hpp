@@ -50,6 +50,8 @@ class Stepper {
   Stepper(const scene::SceneConfig& scene, SimulationState& state, const grid::GridGeometry& geometry,
           grid::KernelOrder order, const materials::MaterialList& materials, const boundary::Boundary& boundary,
           const linalg::SolverConfiguration& solver, const parallel::Communicator& comm);
+  Stepper(const Stepper&) = delete;
+  Stepper& operator=(const Stepper&) = delete;
 
   /// Advances to time t_end. Throws SimulationError if a step fails at the smallest Δt. Returns
   /// false when `after_step` asked to stop (the state is then that after the last step taken).
