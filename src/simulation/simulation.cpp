@@ -12,7 +12,7 @@
 #include "viscompm/io/checkpoint.hpp"
 #include "viscompm/io/collider_output.hpp"
 #include "viscompm/io/particle_file.hpp"
-#include "viscompm/simulation/stop_request.hpp"
+#include "viscompm/core/stop_request.hpp"
 
 namespace viscompm::simulation {
 
@@ -174,6 +174,7 @@ RunSummary Simulation::run(std::ostream& log) {
   for (int frame = first; frame <= frames; ++frame) {
     if (!stepper_.advance_to(frame * frame_duration, summary, &log, after_step)) break;
     write_frame(frame);
+    if (after_step()) break;  // a stop request that came while the frame was written
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const int done = frame - first + 1;
     if (comm_.is_root())
@@ -212,9 +213,14 @@ void Simulation::write_surface(int frame) const {
   for (std::size_t p = 0; p < positions.size(); ++p) positions[p] = Vec3(all[3 * p], all[3 * p + 1], all[3 * p + 2]);
   std::ostringstream name;
   name << scene_.output.directory << "/surface_" << std::setw(5) << std::setfill('0') << frame;
-  const geometry::TriangleMesh surface =
-      geometry::particle_surface(positions, spacing, scene_.output.surface_voxel_size, name.str() + ".vdb");
-  geometry::write_obj(surface, name.str() + ".obj");
+  try {
+    const geometry::TriangleMesh surface =
+        geometry::particle_surface(positions, spacing, scene_.output.surface_voxel_size, name.str() + ".vdb");
+    geometry::write_obj(surface, name.str() + ".obj");
+  } catch (const StopRequested&) {
+    // A stop request while the surface was built: the frame stays without it, and the run stops
+    // after the frame (run()).
+  }
 }
 
 }  // namespace viscompm::simulation

@@ -27,6 +27,15 @@ class SimulationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A stop request (SIGTERM, SIGINT, SIGUSR1: core/stop_request.hpp) that ended a computation which
+/// has no state worth a checkpoint (setting the run up). Exit code 4.
+class StopRequested : public std::runtime_error {
+ public:
+  explicit StopRequested(int signal_number)
+      : std::runtime_error("stopped by signal " + std::to_string(signal_number)), signal(signal_number) {}
+  int signal;
+};
+
 inline constexpr int exit_success = 0;
 inline constexpr int exit_bad_input = 2;
 inline constexpr int exit_simulation_failed = 3;
