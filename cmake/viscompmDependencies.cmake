@@ -2,12 +2,23 @@
 # use an installed viscompm (viscompmConfig.cmake includes this file). Where a dependency ships
 # an imported target it is used (MPI::MPI_CXX, Eigen3::Eigen, hdf5::hdf5); Debian's Trilinos 13.2
 # ships none, so its include directories and libraries are gathered into viscompm::trilinos.
-find_package(MPI REQUIRED COMPONENTS C CXX)
+# Only what a consumer needs: MPI's C++ interface (no C compiler is asked for).
+find_package(MPI REQUIRED COMPONENTS CXX)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
-set(HDF5_PREFER_PARALLEL TRUE)
-find_package(HDF5 REQUIRED COMPONENTS C)
-if(NOT HDF5_IS_PARALLEL)
-  message(FATAL_ERROR "viscompm needs parallel HDF5 (Debian: libhdf5-openmpi-dev)")
+if(DEFINED VISCOMPM_HDF5_LIBRARIES)
+  # An installed viscompm (viscompmConfig.cmake): the parallel HDF5 it was built with, as the
+  # target its libraries name. FindHDF5 would need the consumer to enable the C language.
+  if(NOT TARGET hdf5::hdf5)
+    add_library(hdf5::hdf5 INTERFACE IMPORTED)
+    set_target_properties(hdf5::hdf5 PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${VISCOMPM_HDF5_INCLUDE_DIRS}"
+                                                INTERFACE_LINK_LIBRARIES "${VISCOMPM_HDF5_LIBRARIES}")
+  endif()
+else()
+  set(HDF5_PREFER_PARALLEL TRUE)
+  find_package(HDF5 REQUIRED COMPONENTS C)
+  if(NOT HDF5_IS_PARALLEL)
+    message(FATAL_ERROR "viscompm needs parallel HDF5 (Debian: libhdf5-openmpi-dev)")
+  endif()
 endif()
 # Meshes (Assimp) and level sets (OpenVDB, which needs TBB and Boost.Iostreams): geometry/ only.
 find_package(assimp REQUIRED)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plot a viscompm-study steps.csv: wall seconds per frame of each configuration, split into the
 phases of the Newton solve (operator preparation, preconditioner set-up, CG, line search) and the
-rest of the step, with Newton and CG iteration counts. Usage: plot_steps.py steps.csv steps.png"""
+rest of the step, with Newton and CG iteration counts (one bar per configuration and cell size). Usage: plot_steps.py steps.csv steps.png"""
 import csv
 import sys
 
@@ -11,7 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 rows = list(csv.DictReader(open(sys.argv[1])))
-labels = [r["configuration"] for r in rows]
+several_sizes = len({r.get("cell_size") for r in rows}) > 1
+labels = [f'{r["configuration"]}, Δx {r["cell_size"]}' if several_sizes else r["configuration"] for r in rows]
 frames = [float(r["frames"]) for r in rows]
 phases = [("operator_seconds", "operator (assembly / matrix-free set-up)"),
           ("preconditioner_seconds", "preconditioner set-up"), ("cg_seconds", "CG"),

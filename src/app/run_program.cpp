@@ -9,7 +9,7 @@
 #include "viscompm/linalg/environment.hpp"
 #include "viscompm/scene/command_line.hpp"
 #include "viscompm/simulation/simulation.hpp"
-#include "viscompm/simulation/stop_request.hpp"
+#include "viscompm/core/stop_request.hpp"
 
 namespace viscompm::app {
 
@@ -23,6 +23,12 @@ int run_with_exit_codes(const std::string& program, const parallel::Communicator
   } catch (const SimulationError& e) {
     if (comm.is_root()) std::cerr << program << ": failed: " << e.what() << std::endl;
     return exit_simulation_failed;
+  } catch (const StopRequested& e) {
+    // While the run was set up: nothing simulated, nothing to continue from.
+    if (comm.is_root())
+      std::cerr << program << ": stopped by signal " << e.signal << " (" << strsignal(e.signal)
+              << ") while the run was set up; nothing was simulated" << std::endl;
+    return exit_interrupted;
   } catch (const std::exception& e) {
     std::cerr << program << ": internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
     MPI_Abort(MPI_COMM_WORLD, exit_simulation_failed);
@@ -32,7 +38,7 @@ int run_with_exit_codes(const std::string& program, const parallel::Communicator
 
 int run_simulation_program(int argc, char** argv) {
   linalg::Environment environment(&argc, &argv);
-  simulation::install_stop_handlers();
+  install_stop_handlers();
   const parallel::Communicator comm(MPI_COMM_WORLD);
   const bool root = comm.is_root();
   return run_with_exit_codes("viscompm", comm, [&] {
@@ -52,7 +58,7 @@ int run_simulation_program(int argc, char** argv) {
       return exit_success;
     }
     const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
-    const linalg::SolverConfiguration solver = linalg::SolverConfiguration::read(scene.solver_file);
+    const linalg::SolverConfiguration solver = scene::solver_configuration(scene);
     simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);
     if (summary.stop_signal != 0) {

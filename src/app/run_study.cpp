@@ -52,7 +52,7 @@ int run_study_program(int argc, char** argv) {
     }
     const study::StudySettings settings = study::read_study(cl.input_file, cl.overrides);
     const int rows = study::run_study(settings, cl.input_file, comm, std::cout);
-    const bool steps = settings.mode == "steps";
+    const bool steps = settings.mode == study::StudyMode::steps;
     const std::string csv = settings.output_directory + (steps ? "/steps.csv" : "/study.csv");
     if (root) {
       std::cout << "wrote " << rows << " rows to " << csv << "\n";

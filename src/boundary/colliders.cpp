@@ -7,13 +7,6 @@
 
 namespace viscompm::boundary {
 
-ContactType contact_type_from_name(const std::string& name) {
-  if (name == "sticky") return ContactType::sticky;
-  if (name == "slip") return ContactType::slip;
-  if (name == "separating") return ContactType::separating;
-  throw InputError("unknown contact type '" + name + "' (expected sticky, slip or separating)");
-}
-
 double Collider::signed_distance(const Vec3& x, double t) const {
   return shape.signed_distance(transform_at(t).inverse(x));
 }

@@ -8,16 +8,6 @@
 
 namespace viscompm {
 
-Shape::Kind Shape::kind_from_name(const std::string& name) {
-  if (name == "box") return Kind::box;
-  if (name == "sphere") return Kind::sphere;
-  if (name == "cylinder") return Kind::cylinder;
-  if (name == "half_space") return Kind::half_space;
-  if (name == "mesh") return Kind::mesh;
-  if (name == "cuts") return Kind::cuts;
-  throw InputError("unknown shape '" + name + "'");
-}
-
 std::string Shape::kind_name(Kind kind) {
   switch (kind) {
     case Kind::box: return "box";

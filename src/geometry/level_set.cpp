@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "viscompm/core/error.hpp"
+#include "viscompm/core/stop_request.hpp"
 
 namespace viscompm::geometry {
 
@@ -16,6 +17,16 @@ namespace {
 void initialize_openvdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
+}
+
+// OpenVDB's long operations ask this whether to go on: a stop request (a signal) ends them, and
+// the caller then throws StopRequested.
+struct StopInterrupter : openvdb::util::NullInterrupter {
+  bool wasInterrupted(int = -1) override { return stop_signal() != 0; }
+};
+
+void throw_if_stopped() {
+  if (const int signal = stop_signal()) throw StopRequested(signal);
 }
 }  // namespace
 
@@ -34,8 +45,10 @@ LevelSet::LevelSet(const TriangleMesh& mesh, double voxel_size, int band_voxels)
   for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
   const auto transform = openvdb::math::Transform::createLinearTransform(voxel_size);
   // Unsigned distances in the band, signs by flood fill from outside (meshToLevelSet, §5.6).
-  impl_->grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles,
+  StopInterrupter interrupter;
+  impl_->grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *transform, points, triangles,
                                                                     static_cast<float>(band_voxels));
+  throw_if_stopped();
   mesh.bounding_box(lo_, hi_);
 }
 
@@ -73,11 +86,13 @@ TriangleMesh particle_surface(const std::vector<Vec3>& positions, double radius,
   initialize_openvdb();
   auto grid = openvdb::createLevelSet<openvdb::FloatGrid>(voxel_size, 3.0);
   {
-    openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid> raster(*grid);
+    StopInterrupter interrupter;
+    openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid, void, StopInterrupter> raster(*grid, &interrupter);
     raster.setRmin(0.5);
     raster.rasterizeSpheres(ParticleList{positions, radius});
     raster.finalize(true);
   }
+  throw_if_stopped();
   grid->setName("surface");
   if (!vdb_file.empty()) {
     try {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include "viscompm/core/error.hpp"
 
@@ -31,9 +32,21 @@ void TriangleMesh::bounding_box(Vec3& lo, Vec3& hi) const {
 TriangleMesh read_mesh(const std::string& file) {
   if (!std::filesystem::is_regular_file(file)) throw InputError(file + ": no such mesh file");
   Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(file, 0);
+  if (scene == nullptr) throw InputError(file + ": cannot read the mesh (" + importer.GetErrorString() + ")");
+  // Every vertex as the file has it, before Assimp merges any: a non-finite corner would merge
+  // into another (its comparisons are false) and poison every distance of the level set.
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+    for (unsigned v = 0; v < scene->mMeshes[m]->mNumVertices; ++v) {
+      const aiVector3D& x = scene->mMeshes[m]->mVertices[v];
+      if (std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z)) continue;
+      std::ostringstream reason;
+      reason << file << ": a vertex (" << x.x << " " << x.y << " " << x.z << ") is not finite";
+      throw InputError(reason.str());
+    }
   // Triangulate polygons and merge the duplicated corners STL files store per triangle.
-  const aiScene* scene = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                                     aiProcess_FindDegenerates | aiProcess_SortByPType);
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                       aiProcess_FindDegenerates | aiProcess_SortByPType);
   if (scene == nullptr) throw InputError(file + ": cannot read the mesh (" + importer.GetErrorString() + ")");
   TriangleMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

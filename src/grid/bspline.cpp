@@ -6,12 +6,6 @@
 
 namespace viscompm::grid {
 
-KernelOrder kernel_order_from_name(const std::string& name) {
-  if (name == "quadratic") return KernelOrder::quadratic;
-  if (name == "cubic") return KernelOrder::cubic;
-  throw InputError("unknown kernel '" + name + "' (expected quadratic or cubic)");
-}
-
 std::string kernel_name(KernelOrder order) {
   return order == KernelOrder::quadratic ? "quadratic" : "cubic";
 }

@@ -110,7 +110,7 @@ void write_xdmf(const std::string& directory, const std::vector<FrameInfo>& fram
             << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file
             << ":/colliders/vertices</DataItem></Geometry>\n"
             << "    <Attribute Name=\"collider_id\" AttributeType=\"Scalar\" Center=\"Cell\"><DataItem Dimensions=\"" << nt
-            << " 1\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << file
+            << "\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << file
             << ":/colliders/collider_id</DataItem></Attribute>\n"
             << "   </Grid>\n";
       }

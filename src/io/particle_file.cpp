@@ -182,6 +182,64 @@ herr_t collect_attribute(hid_t location, const char* name, const H5A_info_t*, vo
 }
 }  // namespace
 
+namespace {
+// Every stored field and the derived tensors under /particles, this rank's rows at `start`
+// (collective). After each dataset the ranks agree whether to go on, so that no rank enters a
+// collective write the others have abandoned; returns true if abandoned.
+bool write_particles(WriteStatus& status, hid_t file, const particles::ParticleSet& particles,
+                     const std::vector<DerivedTensor>& derived, const std::string& material_names,
+                     const parallel::Communicator& comm, hsize_t start, hsize_t total) {
+  const hid_t group = H5Gcreate2(file, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  status.check(group, "create /particles");
+  const auto rows = static_cast<hsize_t>(particles.size());
+  bool abandoned = comm.any(!status.failed.empty());
+  particles.for_each_field([&](const char* name, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    if (abandoned) return;
+    write_rows(status, group, name, memory_type<T>(), flatten(field), row_shape<T>(), rows, start, total);
+    abandoned = comm.any(!status.failed.empty());
+  });
+  for (const auto& d : derived) {
+    if (abandoned) break;
+    std::vector<Mat3> values(particles.size());
+    for (std::size_t p = 0; p < values.size(); ++p) values[p] = d.value(p);
+    write_rows(status, group, d.name, H5T_NATIVE_DOUBLE, flatten(values), {3, 3}, rows, start, total);
+    abandoned = comm.any(!status.failed.empty());
+  }
+  write_string_attribute(status, group, "material_names", material_names);
+  status.check(H5Gclose(group), "close /particles");
+  return abandoned;
+}
+
+// The tables, rows from rank 0 (collective creation); a table of one column is a vector (m), of
+// several a matrix (m, columns).
+void write_tables(WriteStatus& status, hid_t file, const std::vector<Table>& tables, const parallel::Communicator& comm,
+                  bool abandoned) {
+  for (const Table& table : tables) {
+    if (abandoned) break;
+    const auto slash = table.path.rfind('/');
+    hid_t parent = file;
+    if (slash != std::string::npos) {
+      const std::string group_name = table.path.substr(0, slash);
+      parent = H5Lexists(file, group_name.c_str(), H5P_DEFAULT) > 0
+                   ? H5Gopen2(file, group_name.c_str(), H5P_DEFAULT)
+                   : H5Gcreate2(file, group_name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      status.check(parent, "create /" + group_name);
+    }
+    const std::string name = slash == std::string::npos ? table.path : table.path.substr(slash + 1);
+    const std::size_t size = table.integers.empty() ? table.reals.size() : table.integers.size();
+    const hsize_t rows_total = size / table.columns, rows_here = comm.is_root() ? rows_total : 0;
+    const std::vector<hsize_t> shape = table.columns == 1 ? std::vector<hsize_t>{} : std::vector<hsize_t>{table.columns};
+    if (table.integers.empty())
+      write_rows(status, parent, name, H5T_NATIVE_DOUBLE, table.reals, shape, rows_here, 0, rows_total);
+    else
+      write_rows(status, parent, name, H5T_NATIVE_INT64, table.integers, shape, rows_here, 0, rows_total);
+    if (parent != file && parent >= 0) H5Gclose(parent);
+    abandoned = comm.any(!status.failed.empty());
+  }
+}
+}  // namespace
+
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
                                  const std::string& material_names, const parallel::Communicator& comm,
@@ -206,50 +264,9 @@ std::int64_t write_particle_file(const std::string& path, const FileAttributes& 
   for (const auto& [name, value] : attributes.strings) write_string_attribute(status, file, name, value);
   for (const auto& [name, values] : attributes.real_arrays)
     write_rows(status, file, name, H5T_NATIVE_DOUBLE, values, {}, comm.is_root() ? values.size() : 0, 0, values.size());
-  const hid_t group = H5Gcreate2(file, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  status.check(group, "create /particles");
-  const auto rows = static_cast<hsize_t>(n_local), start = static_cast<hsize_t>(offset),
-             total = static_cast<hsize_t>(n_total);
-  // After each dataset the ranks agree whether to go on, so that no rank enters a collective
-  // write the others have abandoned.
-  bool abandoned = comm.any(!status.failed.empty());
-  particles.for_each_field([&](const char* name, const auto& field) {
-    using T = typename std::decay_t<decltype(field)>::value_type;
-    if (abandoned) return;
-    write_rows(status, group, name, memory_type<T>(), flatten(field), row_shape<T>(), rows, start, total);
-    abandoned = comm.any(!status.failed.empty());
-  });
-  for (const auto& d : derived) {
-    if (abandoned) break;
-    std::vector<Mat3> values(particles.size());
-    for (std::size_t p = 0; p < values.size(); ++p) values[p] = d.value(p);
-    write_rows(status, group, d.name, H5T_NATIVE_DOUBLE, flatten(values), {3, 3}, rows, start, total);
-    abandoned = comm.any(!status.failed.empty());
-  }
-  write_string_attribute(status, group, "material_names", material_names);
-  status.check(H5Gclose(group), "close /particles");
-  for (const Table& table : tables) {
-    // Collective creation, rows from rank 0.
-    if (abandoned) break;
-    const auto slash = table.path.rfind('/');
-    hid_t parent = file;
-    if (slash != std::string::npos) {
-      const std::string group_name = table.path.substr(0, slash);
-      parent = H5Lexists(file, group_name.c_str(), H5P_DEFAULT) > 0
-                   ? H5Gopen2(file, group_name.c_str(), H5P_DEFAULT)
-                   : H5Gcreate2(file, group_name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-      status.check(parent, "create /" + group_name);
-    }
-    const std::string name = slash == std::string::npos ? table.path : table.path.substr(slash + 1);
-    const std::size_t size = table.integers.empty() ? table.reals.size() : table.integers.size();
-    const hsize_t rows_total = size / table.columns, rows_here = comm.is_root() ? rows_total : 0;
-    if (table.integers.empty())
-      write_rows(status, parent, name, H5T_NATIVE_DOUBLE, table.reals, {table.columns}, rows_here, 0, rows_total);
-    else
-      write_rows(status, parent, name, H5T_NATIVE_INT64, table.integers, {table.columns}, rows_here, 0, rows_total);
-    if (parent != file && parent >= 0) H5Gclose(parent);
-    abandoned = comm.any(!status.failed.empty());
-  }
+  const bool abandoned = write_particles(status, file, particles, derived, material_names, comm,
+                                         static_cast<hsize_t>(offset), static_cast<hsize_t>(n_total));
+  write_tables(status, file, tables, comm, abandoned);
   status.check(H5Fclose(file), "close");
   // Every rank learns whether any failed; the file becomes visible only when complete.
   std::string failure;

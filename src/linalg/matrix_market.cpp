@@ -7,7 +7,9 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "krylov.hpp"
 #include "preconditioner.hpp"
@@ -121,7 +123,7 @@ std::shared_ptr<const SystemGrid> grid_from_coordinates(const multivector_type& 
     lowest[d] = comm.min(lowest[d]);
   }
   spacing = comm.min(spacing);
-  if (!std::isfinite(spacing)) throw InputError("node coordinates: fewer than two distinct positions");
+  if (!std::isfinite(spacing)) throw InputError("fewer than two distinct node positions");
   auto grid = std::make_shared<SystemGrid>();
   Int3 highest = Int3::Zero();
   for (std::size_t i = 0; i < n; ++i) {
@@ -140,6 +142,89 @@ std::shared_ptr<const SystemGrid> grid_from_coordinates(const multivector_type& 
 }
 }  // namespace
 
+namespace {
+// Checks what Tpetra's reader takes on trust in a coordinate file: that it holds as many entries
+// as its size line announces (a cut file was read as a smaller matrix) and that every entry is a
+// pair of indices in range with a finite value. Empty if sound, else the reason (rank 0 reads).
+std::string coordinate_file_problem(const std::string& file) {
+  std::ifstream in(file);
+  std::string line;
+  if (!std::getline(in, line)) return "empty file";
+  try {
+    const Teuchos::MatrixMarket::Banner banner(line);
+    if (banner.matrixType() != "coordinate" || banner.dataType() != "real")
+      return "not a real coordinate matrix (" + banner.matrixType() + " " + banner.dataType() + ")";
+  } catch (const std::exception&) {
+    return "no MatrixMarket banner (%%MatrixMarket matrix coordinate real ...)";
+  }
+  while (std::getline(in, line) && (line.empty() || line[0] == '%')) {
+  }
+  long long rows = -1, columns = -1, entries = -1;
+  if (std::sscanf(line.c_str(), "%lld %lld %lld", &rows, &columns, &entries) != 3 || rows < 0 || columns < 0 || entries < 0)
+    return "no size line (rows columns entries)";
+  long long found = 0;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '%') continue;
+    long long i = 0, j = 0;
+    double value = 0.0;
+    int used = 0;
+    if (std::sscanf(line.c_str(), "%lld %lld %lf%n", &i, &j, &value, &used) != 3 ||
+        line.find_first_not_of(" \t\r", used) != std::string::npos)
+      return "entry " + std::to_string(found + 1) + " ('" + line.substr(0, 60) + "') is not 'row column value'";
+    if (i < 1 || i > rows || j < 1 || j > columns)
+      return "entry " + std::to_string(found + 1) + " (" + std::to_string(i) + ", " + std::to_string(j) +
+             ") lies outside the " + std::to_string(rows) + " x " + std::to_string(columns) + " matrix";
+    if (!std::isfinite(value)) return "entry " + std::to_string(found + 1) + " is not a finite number";
+    if (++found > entries) break;
+  }
+  if (found != entries)
+    return "its size line announces " + std::to_string(entries) + " entries, the file holds " +
+           (found > entries ? "more" : "only " + std::to_string(found)) + " (cut short or corrupted?)";
+  return {};
+}
+
+// Rank 0's answer, on every rank.
+std::string broadcast(const std::string& text, const parallel::Communicator& comm) {
+  int size = static_cast<int>(text.size());
+  MPI_Bcast(&size, 1, MPI_INT, 0, comm.comm());
+  std::string received = comm.is_root() ? text : std::string(size, ' ');
+  MPI_Bcast(received.data(), size, MPI_CHAR, 0, comm.comm());
+  return received;
+}
+
+// The last line of a Trilinos exception (its reason; the lines before name the source).
+std::string last_line(const std::string& message) {
+  std::istringstream in(message);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t-") != std::string::npos) last = line;
+  return last.substr(0, 200);
+}
+
+// A dense MatrixMarket file (right-hand side, coordinates) of `map`'s rows: InputError naming the
+// file when Tpetra cannot read it (cut short, a word for a number, the wrong size) or a value is
+// not finite.
+Teuchos::RCP<multivector_type> read_dense(const std::string& file, const Teuchos::RCP<const Teuchos::Comm<int>>& comm,
+                                          const Teuchos::RCP<const map_type>& map, const std::string& what) {
+  using reader = Tpetra::MatrixMarket::Reader<crs_matrix_type>;
+  Teuchos::RCP<multivector_type> values;
+  try {
+    Teuchos::RCP<const map_type> rows = map;  // the reader takes it by reference
+    values = reader::readDenseFile(file, comm, rows);
+  } catch (const std::exception& e) {
+    throw InputError(file + ": not a readable MatrixMarket array of " + what + " (" + last_line(e.what()) + ")");
+  }
+  bool finite = true;
+  auto host = values->getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t i = 0; i < host.extent(0); ++i)
+    for (std::size_t k = 0; k < host.extent(1); ++k) finite &= std::isfinite(host(i, k));
+  int all_finite = finite ? 1 : 0;
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, 1, &all_finite, &all_finite);
+  if (!all_finite) throw InputError(file + ": a value of the " + what + " is not a finite number");
+  return values;
+}
+}  // namespace
+
 struct MatrixMarketProblem::Impl {
   Teuchos::RCP<crs_matrix_type> A;
   Teuchos::RCP<multivector_type> b;
@@ -148,18 +233,23 @@ struct MatrixMarketProblem::Impl {
 
 MatrixMarketProblem::MatrixMarketProblem(const std::string& matrix_file, const parallel::Communicator& comm)
     : impl_(std::make_unique<Impl>()) {
-  if (!std::ifstream(matrix_file).good()) throw InputError(matrix_file + ": cannot open file");
+  if (comm.any(!std::ifstream(matrix_file).good())) throw InputError(matrix_file + ": cannot open file");
+  const std::string problem = broadcast(comm.is_root() ? coordinate_file_problem(matrix_file) : std::string(), comm);
+  if (!problem.empty()) throw InputError(matrix_file + ": not a readable MatrixMarket matrix: " + problem);
   const auto tcomm = Teuchos::rcp(new Teuchos::MpiComm<int>(comm.comm()));
   using reader = Tpetra::MatrixMarket::Reader<crs_matrix_type>;
   Teuchos::RCP<crs_matrix_type> A;
   try {
     A = reader::readSparseFile(matrix_file, tcomm);
   } catch (const std::exception& e) {
-    throw InputError(matrix_file + ": not a readable MatrixMarket matrix");
+    throw InputError(matrix_file + ": not a readable MatrixMarket matrix (" + last_line(e.what()) + ")");
   }
+  if (A->getGlobalNumRows() != A->getGlobalNumCols())
+    throw InputError(matrix_file + ": the matrix is not square (" + std::to_string(A->getGlobalNumRows()) + " x " +
+                     std::to_string(A->getGlobalNumCols()) + ")");
   // With coordinates: rows by node, so that the 3 dofs of a node share a rank (MueLu's blocks).
   const std::string coordinates_file = coordinates_file_for(matrix_file);
-  if (std::ifstream(coordinates_file).good()) {
+  if (comm.any(std::ifstream(coordinates_file).good())) {
     const auto rows = A->getGlobalNumRows();
     if (rows % 3 != 0) throw InputError(coordinates_file + ": the matrix has " + std::to_string(rows) +
                                         " rows, not 3 per node");
@@ -168,22 +258,23 @@ MatrixMarketProblem::MatrixMarketProblem(const std::string& matrix_file, const p
         Teuchos::rcp(new map_type(rows, 3 * node_map->getNodeNumElements(), 0, tcomm));
     const import_type to_nodes(A->getRowMap(), dof_map);
     A = Tpetra::importAndFillCompleteCrsMatrix<crs_matrix_type>(A, to_nodes, dof_map, dof_map);
-    try {
-      impl_->modes.coordinates = reader::readDenseFile(coordinates_file, tcomm, node_map);
-    } catch (const std::exception& e) {
-      throw InputError(coordinates_file + ": not a readable MatrixMarket array of node coordinates");
-    }
+    impl_->modes.coordinates = read_dense(coordinates_file, tcomm, node_map, "node coordinates");
     if (impl_->modes.coordinates->getNumVectors() != 3)
       throw InputError(coordinates_file + ": expected 3 columns (x, y, z)");
     impl_->modes.rigid_body_modes = rigid_body_modes(*impl_->modes.coordinates, dof_map);
-    impl_->modes.grid = grid_from_coordinates(*impl_->modes.coordinates, comm);
+    try {
+      impl_->modes.grid = grid_from_coordinates(*impl_->modes.coordinates, comm);
+    } catch (const InputError& e) {
+      throw InputError(coordinates_file + ": " + e.what());
+    }
   }
   impl_->A = A;
   impl_->b = Teuchos::rcp(new multivector_type(A->getRangeMap(), 1));
   const std::string rhs_file = rhs_file_for(matrix_file);
-  if (std::ifstream(rhs_file).good()) {
-    auto map = A->getRangeMap();
-    impl_->b->assign(*reader::readDenseFile(rhs_file, tcomm, map));
+  if (comm.any(std::ifstream(rhs_file).good())) {
+    const auto b = read_dense(rhs_file, tcomm, A->getRangeMap(), "right-hand side");
+    if (b->getNumVectors() != 1) throw InputError(rhs_file + ": expected 1 column (the right-hand side)");
+    impl_->b->assign(*b);
   } else {
     impl_->b->putScalar(1.0);
   }

@@ -66,7 +66,7 @@ double FlowRule::plastic_coefficient(double dt) const {
 HerschelBulkley::HerschelBulkley(std::string name, const HerschelBulkleyParameters& parameters, std::string model)
     : Material(std::move(name)),
       parameters_(parameters),
-      convention_(viscosity_convention_from_name(parameters.viscosity_convention)),
+      convention_(parameters.viscosity_convention),
       model_(std::move(model)) {}
 
 double HerschelBulkley::wave_speed() const {

@@ -8,13 +8,6 @@
 
 namespace viscompm::materials {
 
-OldroydBUpdate oldroyd_b_update_from_name(const std::string& name) {
-  if (name == "paper") return OldroydBUpdate::paper;
-  if (name == "spd") return OldroydBUpdate::spd;
-  if (name == "f_e") return OldroydBUpdate::f_e;
-  throw InputError("unknown strain update '" + name + "' (expected paper, spd or f_e)");
-}
-
 const ParameterTable<OldroydBParameters>& OldroydBParameters::table() {
   static const ParameterTable<OldroydBParameters> t = [] {
     ParameterTable<OldroydBParameters> table;
@@ -23,7 +16,8 @@ const ParameterTable<OldroydBParameters>& OldroydBParameters::table() {
     add_newtonian_parameters(table);
     table.real(&P::weissenberg, "Weissenberg number", 1.0, Range::positive(),
               "relaxation time Wi of b_OB toward I (§5.4.3) [s]")
-        .string(&P::strain_update, "Strain update", "paper", {"paper", "spd", "f_e"},
+        .choice(&P::strain_update, "Strain update", OldroydBUpdate::paper,
+                {{"paper", OldroydBUpdate::paper}, {"spd", OldroydBUpdate::spd}, {"f_e", OldroydBUpdate::f_e}},
                 "b_OB update: paper (5.14); spd, positive definite for all Δt (§4.6.1); f_e, stores f_e with "
                 "b_OB = f_e f_e^T (§4.7.1)");
     return table;
@@ -145,8 +139,8 @@ bool evaluate_potential(const Coefficients& c, const Mat3& F_n, const FlowStrain
 OldroydB::OldroydB(std::string name, const OldroydBParameters& parameters)
     : Material(std::move(name)),
       parameters_(parameters),
-      convention_(viscosity_convention_from_name(parameters.viscosity_convention)),
-      update_(oldroyd_b_update_from_name(parameters.strain_update)) {}
+      convention_(parameters.viscosity_convention),
+      update_(parameters.strain_update) {}
 
 double OldroydB::wave_speed() const {
   return elastic_wave_speed(parameters_.density, parameters_.shear_modulus, parameters_.lame_lambda);

@@ -1,5 +1,10 @@
 #include "viscompm/parallel/communicator.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+
 namespace viscompm::parallel {
 
 Communicator::Communicator(MPI_Comm comm) : comm_(comm) {
@@ -87,5 +92,24 @@ bool Communicator::any(bool local) const {
 }
 
 void Communicator::barrier() const { MPI_Barrier(comm_); }
+
+double machine_memory() {
+  double bytes = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  for (const char* limit_file : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(limit_file);
+    double limit = 0.0;
+    if (in >> limit && limit > 0.0) bytes = std::min(bytes, limit);
+  }
+  return bytes;
+}
+
+double memory_per_rank(const Communicator& comm) {
+  MPI_Comm node;
+  MPI_Comm_split_type(comm.comm(), MPI_COMM_TYPE_SHARED, comm.rank(), MPI_INFO_NULL, &node);
+  int ranks_here = 1;
+  MPI_Comm_size(node, &ranks_here);
+  MPI_Comm_free(&node);
+  return machine_memory() / ranks_here;
+}
 
 }  // namespace viscompm::parallel

@@ -42,22 +42,11 @@ Int3 index_of(NodeId id, const Int3& dims) {
   return Int3(static_cast<int>(id % nx), static_cast<int>((id / nx) % ny), static_cast<int>(id / (nx * ny)));
 }
 
-// One coarsening: the coarse level under a fine level (its owned nodes' indices `fine`) whose
-// node 0 sits on level-0 index `fine_origin`.
-CoarseLevel coarsen(const Communicator& comm, const Int3& fine_dims, int fine_origin, const std::vector<Int3>& fine,
-                    int level, const Int3& level0_last, const std::function<int(const Int3&)>& owner,
-                    Prolongation kind) {
-  CoarseLevel c;
-  const int shift = kind == Prolongation::quadratic_bspline ? 1 : 0;
-  c.spacing = 1 << level;
-  c.origin = fine_origin - shift * c.spacing;
-  c.dimensions = fine_dims.unaryExpr([shift](int n) { return n / 2 + 1 + 2 * shift; });
-  auto owner_of = [&](const Int3& ijk) {
-    return owner((Int3::Constant(c.origin) + c.spacing * ijk).cwiseMax(0).cwiseMin(level0_last));
-  };
+using ParentRow = std::vector<std::pair<NodeId, double>>;
 
-  // Parents of every owned fine node: the rows of P, by coarse grid id for now.
-  std::vector<std::vector<std::pair<NodeId, double>>> rows(fine.size());
+// The parents of every owned fine node with their weights: the rows of P, by coarse grid id.
+std::vector<ParentRow> parent_rows(Prolongation kind, const std::vector<Int3>& fine, int shift, const Int3& coarse_dims) {
+  std::vector<ParentRow> rows(fine.size());
   Parent px[3], py[3], pz[3];
   for (std::size_t k = 0; k < fine.size(); ++k) {
     const int nx = axis_parents(kind, fine[k].x(), shift, px);
@@ -66,22 +55,28 @@ CoarseLevel coarsen(const Communicator& comm, const Int3& fine_dims, int fine_or
     for (int a = 0; a < nz; ++a)
       for (int b = 0; b < ny; ++b)
         for (int d = 0; d < nx; ++d)
-          rows[k].emplace_back(linear_id(Int3(px[d].index, py[b].index, pz[a].index), c.dimensions),
+          rows[k].emplace_back(linear_id(Int3(px[d].index, py[b].index, pz[a].index), coarse_dims),
                                px[d].weight * py[b].weight * pz[a].weight);
   }
-  // Every parent goes to its owner; the owned coarse nodes are those received or kept.
+  return rows;
+}
+
+// The coarse nodes of `c`: every parent goes to its owner, the owned ones (received or kept) are
+// numbered contiguously by rank, and the ghost parents learn their system ids from their owners
+// (collective).
+void own_parents(const Communicator& comm, const std::vector<ParentRow>& rows,
+                 const std::function<int(const Int3&)>& owner_of, CoarseLevel& c) {
   std::vector<NodeId> referenced;
   for (const auto& row : rows)
     for (const auto& [id, w] : row) referenced.push_back(id);
   std::sort(referenced.begin(), referenced.end());
   referenced.erase(std::unique(referenced.begin(), referenced.end()), referenced.end());
-  std::vector<int> referenced_owner(referenced.size());
   std::vector<std::vector<NodeId>> outgoing(comm.size());
   std::vector<NodeId> owned;
-  for (std::size_t k = 0; k < referenced.size(); ++k) {
-    referenced_owner[k] = comm.size() == 1 ? 0 : owner_of(index_of(referenced[k], c.dimensions));
-    if (referenced_owner[k] == comm.rank()) owned.push_back(referenced[k]);
-    else outgoing[referenced_owner[k]].push_back(referenced[k]);
+  for (const NodeId id : referenced) {
+    const int referenced_owner = comm.size() == 1 ? 0 : owner_of(index_of(id, c.dimensions));
+    if (referenced_owner == comm.rank()) owned.push_back(id);
+    else outgoing[referenced_owner].push_back(id);
   }
   if (comm.size() > 1) {
     for (const auto& incoming : comm.exchange(outgoing)) owned.insert(owned.end(), incoming.begin(), incoming.end());
@@ -95,26 +90,27 @@ CoarseLevel coarsen(const Communicator& comm, const Int3& fine_dims, int fine_or
   if (comm.rank() == 0) offset = 0;
   c.global_count = comm.sum(static_cast<std::int64_t>(owned.size()));
   for (std::size_t k = 0; k < owned.size(); ++k) c.system_ids.push_back(offset + static_cast<std::int64_t>(k));
-
+  if (comm.size() == 1) return;
   // Ghost parents: ask their owners for their system ids (the requests were the `outgoing` lists).
-  if (comm.size() > 1) {
-    const auto requests = comm.exchange(outgoing);
-    std::vector<std::vector<std::int64_t>> answers(comm.size());
-    for (int r = 0; r < comm.size(); ++r)
-      for (const NodeId id : requests[r]) {
-        const auto it = std::lower_bound(owned.begin(), owned.end(), id);
-        answers[r].push_back(offset + static_cast<std::int64_t>(it - owned.begin()));
-      }
-    const auto replies = comm.exchange(answers);
-    // Ghosts by owner, then id: the outgoing lists are sorted by id within each owner.
-    for (int r = 0; r < comm.size(); ++r)
-      for (std::size_t k = 0; k < outgoing[r].size(); ++k) {
-        c.nodes.push_back(outgoing[r][k]);
-        c.system_ids.push_back(replies[r][k]);
-        c.ghost_owners.push_back(r);
-      }
-  }
-  // Rows with local column indices, ascending.
+  const auto requests = comm.exchange(outgoing);
+  std::vector<std::vector<std::int64_t>> answers(comm.size());
+  for (int r = 0; r < comm.size(); ++r)
+    for (const NodeId id : requests[r]) {
+      const auto it = std::lower_bound(owned.begin(), owned.end(), id);
+      answers[r].push_back(offset + static_cast<std::int64_t>(it - owned.begin()));
+    }
+  const auto replies = comm.exchange(answers);
+  // Ghosts by owner, then id: the outgoing lists are sorted by id within each owner.
+  for (int r = 0; r < comm.size(); ++r)
+    for (std::size_t k = 0; k < outgoing[r].size(); ++k) {
+      c.nodes.push_back(outgoing[r][k]);
+      c.system_ids.push_back(replies[r][k]);
+      c.ghost_owners.push_back(r);
+    }
+}
+
+// The rows of P with local column indices, ascending.
+void local_rows(const std::vector<ParentRow>& rows, CoarseLevel& c) {
   std::unordered_map<NodeId, int> local;
   local.reserve(c.nodes.size());
   for (std::size_t k = 0; k < c.nodes.size(); ++k) local.emplace(c.nodes[k], static_cast<int>(k));
@@ -130,6 +126,24 @@ CoarseLevel coarsen(const Communicator& comm, const Int3& fine_dims, int fine_or
     }
     c.row_begin.push_back(c.columns.size());
   }
+}
+
+// One coarsening: the coarse level under a fine level (its owned nodes' indices `fine`) whose
+// node 0 sits on level-0 index `fine_origin`.
+CoarseLevel coarsen(const Communicator& comm, const Int3& fine_dims, int fine_origin, const std::vector<Int3>& fine,
+                    int level, const Int3& level0_last, const std::function<int(const Int3&)>& owner,
+                    Prolongation kind) {
+  CoarseLevel c;
+  const int shift = kind == Prolongation::quadratic_bspline ? 1 : 0;
+  c.spacing = 1 << level;
+  c.origin = fine_origin - shift * c.spacing;
+  c.dimensions = fine_dims.unaryExpr([shift](int n) { return n / 2 + 1 + 2 * shift; });
+  auto owner_of = [&](const Int3& ijk) {
+    return owner((Int3::Constant(c.origin) + c.spacing * ijk).cwiseMax(0).cwiseMin(level0_last));
+  };
+  const std::vector<ParentRow> rows = parent_rows(kind, fine, shift, c.dimensions);
+  own_parents(comm, rows, owner_of, c);
+  local_rows(rows, c);
   return c;
 }
 }  // namespace

@@ -6,6 +6,7 @@
 #include <Teuchos_XMLParameterListHelpers.hpp>
 #include <Teuchos_XMLParameterListReader.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -265,8 +266,10 @@ std::string teuchos_reason(const std::string& message) {
   return last.substr(0, 160);
 }
 
-// Teuchos reads a number with atof-like leniency ("none" becomes 0): numbers must be whole
-// tokens. Empty if `value` is a valid `type` (double, int or an array of them, or any other type).
+// Teuchos reads a number with atof-like leniency ("none" becomes 0) and turns the items of an
+// Array(double) that are not finite into 0 ("nan", "inf") or the largest double ("1e400"):
+// numbers must be whole tokens, and real ones finite. Empty if `value` is a valid `type`
+// (double, int or an array of them, or any other type).
 std::string number_problem(const std::string& type, const std::string& value) {
   const bool real = type == "double" || type == "Array(double)";
   const bool integer = type == "int" || type == "Array(int)";
@@ -282,10 +285,13 @@ std::string number_problem(const std::string& type, const std::string& value) {
   for (const auto& token : tokens) {
     char* end = nullptr;
     const std::string trimmed = token.substr(0, token.find_last_not_of(" \t") + 1);
-    if (real) std::strtod(trimmed.c_str(), &end);
+    double x = 0.0;
+    if (real) x = std::strtod(trimmed.c_str(), &end);
     else std::strtol(trimmed.c_str(), &end, 10);
     if (trimmed.empty() || end != trimmed.c_str() + trimmed.size())
       return "value '" + value + "' is not a valid " + type;
+    if (real && !std::isfinite(x))
+      return "value '" + value + (type == "double" ? "' " : "': item '" + trimmed + "' ") + "is not a finite number";
   }
   return {};
 }

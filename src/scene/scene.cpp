@@ -9,8 +9,9 @@
 #include "viscompm/core/error.hpp"
 #include "viscompm/core/shape.hpp"
 #include "viscompm/geometry/level_set.hpp"
-#include "viscompm/materials/registry.hpp"
+#include "viscompm/parallel/communicator.hpp"
 #include "viscompm/params/parameter_io.hpp"
+#include "default_solver_xml.hpp"  // generated: cmake/viscompmDefaultSolver.cmake
 
 namespace viscompm::scene {
 
@@ -19,6 +20,19 @@ using params::parse_value;
 using params::read_parameters;
 using params::read_xml_file;
 using params::set_entry;
+
+namespace {
+const std::vector<std::pair<std::string, boundary::ContactType>> contact_words = {
+    {"sticky", boundary::ContactType::sticky},
+    {"slip", boundary::ContactType::slip},
+    {"separating", boundary::ContactType::separating}};
+
+std::string number_text(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+}  // namespace
 
 const ParameterTable<SimulationSettings>& SimulationSettings::table() {
   static const ParameterTable<SimulationSettings> t = [] {
@@ -29,15 +43,20 @@ const ParameterTable<SimulationSettings>& SimulationSettings::table() {
         .real(&S::cfl, "CFL", 0.5, Range::open_closed(0.0, 10.0), "Δt ≤ CFL·Δx / max particle speed")
         .real(&S::max_time_step, "Max time step", 1e-2, Range::positive(), "upper bound of Δt [s]")
         .real(&S::min_time_step, "Min time step", 1e-7, Range::positive(),
-              "smallest Δt tried when a step fails before the run stops [s]")
+              "smallest Δt tried when a step fails before the run stops [s]; a speed whose CFL step is smaller "
+              "is bad input")
         .real(&S::time_step_growth, "Time step growth", 1.5, Range::open_closed(1.0, 10.0),
               "after each successful step the Δt cap grows by this factor (up to Max time step)")
         .real(&S::time_step_reduction, "Time step reduction", 0.5, {0.0, 1.0, false, false},
               "a step that fails (Newton, or non-finite values) is retried with Δt times this factor")
         .vector3(&S::gravity, "Gravity", Vec3(0.0, -9.81, 0.0), "gravitational acceleration [m/s^2]")
-        .string(&S::transfer, "Transfer", "apic", {"apic", "pic_flip"}, "particle-grid transfer (§3.4, §5.6)")
+        .choice(&S::transfer, "Transfer", transfer::Scheme::apic,
+                {{"apic", transfer::Scheme::apic}, {"pic_flip", transfer::Scheme::pic_flip}},
+                "particle-grid transfer (§3.4, §5.6)")
         .real(&S::flip_ratio, "FLIP ratio", 0.95, Range::closed(0.0, 1.0), "α of the PIC/FLIP blend (pic_flip only)")
-        .string(&S::kernel, "Kernel", "quadratic", {"quadratic", "cubic"}, "B-spline interpolation (§3.1)");
+        .choice(&S::kernel, "Kernel", grid::KernelOrder::quadratic,
+                {{"quadratic", grid::KernelOrder::quadratic}, {"cubic", grid::KernelOrder::cubic}},
+                "B-spline interpolation (§3.1)");
     return table;
   }();
   return t;
@@ -50,8 +69,9 @@ const ParameterTable<GridSettings>& GridSettings::table() {
     table.vector3(&G::lower_corner, "Lower corner", Vec3::Zero(), "lower corner of the domain [m]")
         .vector3(&G::upper_corner, "Upper corner", Vec3::Ones(), "upper corner of the domain [m]")
         .real(&G::cell_size, "Cell size", 0.05, Range::positive(), "grid spacing Δx [m]")
-        .string(&G::walls, "Walls", "separating", {"sticky", "slip", "separating"}, "contact at the domain faces")
-        .string(&G::outside_particles, "Outside particles", "clamp", {"clamp", "delete"},
+        .choice(&G::walls, "Walls", boundary::ContactType::separating, contact_words, "contact at the domain faces")
+        .choice(&G::outside_particles, "Outside particles", OutsideParticles::clamp,
+                {{"clamp", OutsideParticles::clamp}, {"delete", OutsideParticles::remove}},
                 "particles that reach the last cell of the grid are held there (clamp) or removed and counted (delete)")
         .real(&G::rebalance_threshold, "Rebalance threshold", 1.25, Range::at_least(0.0),
               "re-partition the grid (Zoltan2 RCB of the particles) when the largest rank holds more than this "
@@ -70,12 +90,16 @@ const ParameterTable<GridSettings>& GridSettings::table() {
 }
 
 namespace {
+// OpenVDB's transforms need a voxel whose cube is at least 3e-15 m³ (ScaleMap: "Non-zero scale
+// values required" below).
+constexpr double min_voxel_size = 1.5e-5;
+
 template <class S>
-void add_shape_parameters(ParameterTable<S>& table,
-                          std::vector<std::string> shapes = {"box", "sphere", "cylinder", "half_space", "mesh"}) {
-  const bool mesh = std::find(shapes.begin(), shapes.end(), "mesh") != shapes.end();
-  const bool cuts = std::find(shapes.begin(), shapes.end(), "cuts") != shapes.end();
-  table.string(&S::shape, "Shape", shapes.front(), shapes, "solid shape")
+void add_shape_parameters(ParameterTable<S>& table, const std::vector<std::pair<std::string, ShapeKind>>& shapes) {
+  const auto has = [&](ShapeKind kind) {
+    return std::any_of(shapes.begin(), shapes.end(), [&](const auto& s) { return s.second == kind; });
+  };
+  table.template choice<ShapeKind>(&S::shape, "Shape", shapes.front().second, shapes, "solid shape")
       .vector3(&S::lower_corner, "Lower corner", Vec3::Zero(), "box: lower corner [m]")
       .vector3(&S::upper_corner, "Upper corner", Vec3::Ones(), "box: upper corner [m]")
       .vector3(&S::center, "Center", Vec3::Zero(), "sphere, cylinder: centre; half_space: a point on its plane [m]")
@@ -83,161 +107,16 @@ void add_shape_parameters(ParameterTable<S>& table,
       .vector3(&S::axis, "Axis", Vec3::UnitY(), "cylinder: axis direction")
       .real(&S::length, "Length", 1.0, Range::positive(), "cylinder: length along its axis [m]")
       .vector3(&S::normal, "Normal", Vec3::UnitY(), "half_space: outward normal (the solid is below the plane)");
-  if (mesh)
+  if (has(ShapeKind::mesh))
     table.string(&S::mesh_file, "File", "", {}, "mesh: OBJ or STL file (ASCII or binary), relative to the scene file")
         .real(&S::mesh_scale, "Scale", 1.0, Range::positive(), "mesh: its vertices x are placed at Scale·x + Center")
         .real(&S::voxel_size, "Voxel size", 0.0, Range::non_negative(),
-              "mesh: voxel of its signed distance field [m] (0: a quarter of Grid/Cell size)");
-  if (cuts)
+              "mesh: voxel of its signed distance field [m] (0: a quarter of Grid/Cell size; else at least 1.5e-5, "
+              "OpenVDB's smallest)");
+  if (has(ShapeKind::cuts))
     table.integer(&S::cut_count, "Cut count", 4, Range::closed(1, 64),
                   "cuts: planes through Center containing Axis, 180°/count apart (2·count slices)")
         .real(&S::cut_width, "Cut width", 0.01, Range::positive(), "cuts: thickness of each cut [m]");
-}
-
-Shape make_shape(const ShapeSettings& s, const std::string& file, const std::string& path) {
-  Shape shape;
-  shape.kind = Shape::kind_from_name(s.shape);
-  shape.lower = s.lower_corner;
-  shape.upper = s.upper_corner;
-  shape.center = s.center;
-  shape.radius = s.radius;
-  shape.length = s.length;
-  shape.field = s.field;
-  shape.cut_count = s.cut_count;
-  shape.cut_width = s.cut_width;
-  if (shape.kind == Shape::Kind::mesh && !shape.field && !file.empty())
-    throw InputError(file + ": parameter '" + path + "/File': no mesh loaded");
-  const Vec3 direction = shape.kind == Shape::Kind::half_space ? s.normal : s.axis;
-  if (direction.norm() == 0.0) throw InputError(file + ": parameter '" + path + "': direction must be non-zero");
-  shape.axis = direction.normalized();
-  if (shape.kind == Shape::Kind::box && !(s.upper_corner.array() > s.lower_corner.array()).all())
-    throw InputError(file + ": parameter '" + path + "/Upper corner': must exceed Lower corner in every component");
-  return shape;
-}
-
-// At most 2^53 grid nodes: their ids, and 3 per node for the Newton unknowns, stay exact in the
-// 64-bit integers (and doubles) that hold them.
-constexpr double max_grid_nodes = 9007199254740992.0;
-// Cell indices per dimension are ints.
-constexpr double max_cells_per_dimension = 1073741824.0;
-
-constexpr const char* section_names[] = {"Simulation", "Grid", "Newton", "Solver", "Output", "Materials", "Bodies", "Colliders", "Emitters", "Regions"};
-
-// Reads the mesh of a mesh shape, places it (Scale, Center) and builds its signed distance field;
-// a body or region needs a closed mesh (it has an inside).
-void load_mesh(ShapeSettings& s, const std::string& file, const std::string& path, double cell_size,
-               bool must_be_closed) {
-  if (s.shape != "mesh") return;
-  const std::string where = file + ": parameter '" + path + "/File': ";
-  if (s.mesh_file.empty()) throw InputError(where + "a mesh shape needs a file");
-  const std::filesystem::path mesh_path = std::filesystem::path(s.mesh_file).is_absolute()
-                                              ? std::filesystem::path(s.mesh_file)
-                                              : std::filesystem::path(file).parent_path() / s.mesh_file;
-  geometry::TriangleMesh mesh;
-  try {
-    mesh = geometry::transformed(geometry::read_mesh(mesh_path.lexically_normal().string()), s.mesh_scale, s.center);
-  } catch (const InputError& e) {
-    throw InputError(where + e.what());
-  }
-  if (must_be_closed && !geometry::is_closed(mesh))
-    throw InputError(where + mesh_path.lexically_normal().string() +
-                     ": the mesh is not closed (every edge must join two consistently oriented triangles)");
-  s.field = std::make_shared<geometry::LevelSet>(mesh, s.voxel_size > 0.0 ? s.voxel_size : 0.25 * cell_size);
-}
-
-const std::vector<ParameterSpec>* fixed_section_specs(const std::string& section) {
-  if (section == "Simulation") return &SimulationSettings::table().specs();
-  if (section == "Grid") return &GridSettings::table().specs();
-  if (section == "Newton") return &newton::NewtonSettings::table().specs();
-  if (section == "Solver") return &SolverFileSettings::table().specs();
-  if (section == "Output") return &OutputSettings::table().specs();
-  if (section == "Bodies") return &BodySettings::table().specs();
-  if (section == "Colliders") return &ColliderSettings::table().specs();
-  if (section == "Emitters") return &EmitterSettings::table().specs();
-  if (section == "Regions") return &RegionSettings::table().specs();
-  return nullptr;
-}
-
-ParameterSpec model_spec() {
-  ParameterSpec spec;
-  spec.name = "Model";
-  spec.type = ParameterSpec::Type::string;
-  spec.default_value = std::string();
-  spec.choices = materials::model_names();
-  spec.doc = "constitutive model";
-  return spec;
-}
-
-std::vector<std::string> split_path(const std::string& path) {
-  std::vector<std::string> parts;
-  std::stringstream in(path);
-  for (std::string part; std::getline(in, part, '/');)
-    if (!part.empty()) parts.push_back(part);
-  return parts;
-}
-
-// The declaration of the parameter at `parts` (section[/item]/name) of `list`, or nullptr.
-const ParameterSpec* find_spec(const Teuchos::ParameterList& list, const std::vector<std::string>& parts,
-                               std::vector<ParameterSpec>& storage) {
-  if (parts.size() < 2) return nullptr;
-  const std::string& section = parts[0];
-  const std::string& name = parts.back();
-  const std::vector<ParameterSpec>* specs = nullptr;
-  if (section == "Materials") {
-    if (parts.size() != 3) return nullptr;
-    storage = {model_spec()};
-    const std::string* model = nullptr;
-    if (list.isSublist("Materials") && list.sublist("Materials").isSublist(parts[1]))
-      model = list.sublist("Materials").sublist(parts[1]).getPtr<std::string>("Model");
-    if (model != nullptr)
-      if (const auto* entry = materials::find_model(*model))
-        storage.insert(storage.end(), entry->parameters.begin(), entry->parameters.end());
-    specs = &storage;
-  } else if (section == "Bodies" || section == "Colliders" || section == "Emitters" || section == "Regions") {
-    if (parts.size() != 3) return nullptr;
-    specs = fixed_section_specs(section);
-  } else {
-    if (parts.size() != 2) return nullptr;
-    specs = fixed_section_specs(section);
-  }
-  if (specs == nullptr) return nullptr;
-  for (const auto& s : *specs)
-    if (s.name == name) return &s;
-  return nullptr;
-}
-
-void apply_override(Teuchos::ParameterList& list, const Override& o, const std::string& file) {
-  const auto parts = split_path(o.path);
-  std::vector<ParameterSpec> storage;
-  const ParameterSpec* spec = find_spec(list, parts, storage);
-  if (spec == nullptr) throw InputError(file + ": --set '" + o.path + "': unknown parameter");
-  Teuchos::ParameterList* target = &list;
-  for (std::size_t k = 0; k + 1 < parts.size(); ++k) target = &target->sublist(parts[k]);
-  try {
-    set_entry(*target, parts.back(), parse_value(*spec, o.value));
-  } catch (const InputError& e) {
-    throw InputError(file + ": --set '" + o.path + "': " + e.what());
-  }
-}
-
-template <class Settings>
-Settings read_section(const Teuchos::ParameterList& root, const char* section, const std::string& file) {
-  const Teuchos::ParameterList empty;
-  const Teuchos::ParameterList& list = root.isSublist(section) ? root.sublist(section) : empty;
-  return Settings::table().parse(read_parameters(list, Settings::table().specs(), file, section));
-}
-
-// Each sublist of `section`, read with `read(item_list, path)`.
-template <class F>
-void for_each_item(const Teuchos::ParameterList& root, const char* section, const std::string& file, F&& read) {
-  if (!root.isSublist(section)) return;
-  const Teuchos::ParameterList& list = root.sublist(section);
-  for (auto it = list.begin(); it != list.end(); ++it) {
-    const std::string path = std::string(section) + "/" + list.name(it);
-    if (!list.entry(it).isList())
-      throw InputError(file + ": parameter '" + path + "': expected a sublist (one per item)");
-    read(list.name(it), Teuchos::getValue<Teuchos::ParameterList>(list.entry(it)), path);
-  }
 }
 }  // namespace
 
@@ -245,7 +124,11 @@ const ParameterTable<BodySettings>& BodySettings::table() {
   static const ParameterTable<BodySettings> t = [] {
     ParameterTable<BodySettings> table;
     using B = BodySettings;
-    add_shape_parameters(table);
+    add_shape_parameters(table, {{"box", ShapeKind::box},
+                                 {"sphere", ShapeKind::sphere},
+                                 {"cylinder", ShapeKind::cylinder},
+                                 {"half_space", ShapeKind::half_space},
+                                 {"mesh", ShapeKind::mesh}});
     table.string(&B::material, "Material", "", {}, "name of a sublist of Materials")
         .integer(&B::particles_per_cell, "Particles per cell", 2, Range::closed(1, 8),
                  "particles per cell and dimension")
@@ -261,12 +144,17 @@ const ParameterTable<ColliderSettings>& ColliderSettings::table() {
   static const ParameterTable<ColliderSettings> t = [] {
     ParameterTable<ColliderSettings> table;
     using C = ColliderSettings;
-    add_shape_parameters(table);
-    table.string(&C::contact, "Contact", "sticky", {"sticky", "slip", "separating"},
+    add_shape_parameters(table, {{"box", ShapeKind::box},
+                                 {"sphere", ShapeKind::sphere},
+                                 {"cylinder", ShapeKind::cylinder},
+                                 {"half_space", ShapeKind::half_space},
+                                 {"mesh", ShapeKind::mesh}});
+    table.choice(&C::contact, "Contact", boundary::ContactType::sticky, contact_words,
                  "sticky: nodes inside move with the solid (Dirichlet grips); slip: normal only; separating: slip while approaching")
         .vector3(&C::velocity, "Velocity", Vec3::Zero(), "kinematic velocity [m/s]")
         .real(&C::start_time, "Start time", 0.0, Range::non_negative(), "time the solid starts moving [s]")
-        .real(&C::stop_time, "Stop time", 1e30, Range::non_negative(), "time the solid stops moving [s]")
+        .real(&C::stop_time, "Stop time", 1e30, Range::non_negative(),
+              "time the solid stops moving [s] (not before Start time)")
         .vector3(&C::angular_velocity, "Angular velocity", Vec3::Zero(),
                  "rotation rate ω about an axis through Rotation center [rad/s]: nodes move with v = Velocity + ω × (x − c)")
         .vector3(&C::rotation_center, "Rotation center", Vec3::Zero(),
@@ -289,7 +177,7 @@ const ParameterTable<EmitterSettings>& EmitterSettings::table() {
   static const ParameterTable<EmitterSettings> t = [] {
     ParameterTable<EmitterSettings> table;
     using E = EmitterSettings;
-    add_shape_parameters(table, {"disc", "box", "cylinder"});
+    add_shape_parameters(table, {{"disc", ShapeKind::disc}, {"box", ShapeKind::box}, {"cylinder", ShapeKind::cylinder}});
     table.string(&E::material, "Material", "", {}, "name of a sublist of Materials")
         .vector3(&E::velocity, "Velocity", Vec3::UnitX(),
                  "inflow velocity [m/s]: emitted particles and the nozzle's grid nodes move with it (disc: its normal)")
@@ -308,7 +196,11 @@ const ParameterTable<RegionSettings>& RegionSettings::table() {
   static const ParameterTable<RegionSettings> t = [] {
     ParameterTable<RegionSettings> table;
     using R = RegionSettings;
-    add_shape_parameters(table, {"box", "sphere", "cylinder", "mesh", "cuts"});
+    add_shape_parameters(table, {{"box", ShapeKind::box},
+                                 {"sphere", ShapeKind::sphere},
+                                 {"cylinder", ShapeKind::cylinder},
+                                 {"mesh", ShapeKind::mesh},
+                                 {"cuts", ShapeKind::cuts}});
     table.string(&R::body, "Body", "", {}, "name of a sublist of Bodies whose particles the region re-assigns")
         .string(&R::material, "Material", "", {}, "name of a sublist of Materials: the particles' new material");
     return table;
@@ -319,8 +211,9 @@ const ParameterTable<RegionSettings>& RegionSettings::table() {
 const ParameterTable<SolverFileSettings>& SolverFileSettings::table() {
   static const ParameterTable<SolverFileSettings> t = [] {
     ParameterTable<SolverFileSettings> table;
-    table.string(&SolverFileSettings::file, "File", "../solvers/jacobi_cg.xml", {},
-                 "solver XML, relative to the scene file (--solver overrides it)");
+    table.string(&SolverFileSettings::file, "File", "", {},
+                 "solver XML, relative to the scene file (--solver overrides it); none: the built-in default, "
+                 "Belos CG with Ifpack2 Jacobi (inputs/solvers/jacobi_cg.xml)");
     return table;
   }();
   return t;
@@ -340,7 +233,7 @@ const ParameterTable<OutputSettings>& OutputSettings::table() {
                    "steps whose first Newton system is written to DIR/newton_step_K.mtx and DIR/newton_step_K_rhs.mtx")
         .real(&OutputSettings::surface_voxel_size, "Surface voxel size", 0.0, Range::non_negative(),
               "> 0: write each frame's particle surface (OpenVDB level set of spheres of the particle spacing, "
-              "voxels of this size [m]) to DIR/surface_NNNNN.obj and DIR/surface_NNNNN.vdb; 0: none");
+              "voxels of this size [m], at least 1.5e-5) to DIR/surface_NNNNN.obj and DIR/surface_NNNNN.vdb; 0: none");
     return table;
   }();
   return t;
@@ -353,62 +246,504 @@ Override Override::parse(const std::string& text) {
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
 
+// ---------------------------------------------------------------------------------------------
+// The sections of a scene, each declared once: its name, whether it holds one sublist per item,
+// its parameters and how it is read.
 namespace {
+struct Reading {
+  const std::string& file;
+  SceneConfig& scene;
+};
+
+struct Section {
+  const char* name;
+  bool per_item;  ///< one sublist per item (Bodies/<name>/...)
+  /// The parameters of the section (of `item`, its sublist, for model-dependent materials).
+  std::vector<ParameterSpec> (*specs)(const Teuchos::ParameterList* item);
+  /// Reads the section, or one item (`name`) of it, at `path`.
+  void (*read)(const Teuchos::ParameterList& list, const std::string& name, const std::string& path, Reading& r);
+};
+
+template <class Settings>
+std::vector<ParameterSpec> specs_of(const Teuchos::ParameterList*) {
+  return Settings::table().specs();
+}
+
+template <class Settings>
+Settings parse(const Teuchos::ParameterList& list, const std::string& path, const std::string& file) {
+  return Settings::table().parse(read_parameters(list, Settings::table().specs(), file, path));
+}
+
+ParameterSpec model_spec() {
+  ParameterSpec spec;
+  spec.name = "Model";
+  spec.type = ParameterSpec::Type::string;
+  spec.default_value = std::string();
+  spec.choices = materials::model_names();
+  spec.doc = "constitutive model";
+  return spec;
+}
+
+// "Model" and, once it names a model, that model's parameters.
+std::vector<ParameterSpec> material_specs(const Teuchos::ParameterList* item) {
+  std::vector<ParameterSpec> specs = {model_spec()};
+  const std::string* model = item != nullptr ? item->getPtr<std::string>("Model") : nullptr;
+  if (model != nullptr)
+    if (const auto* entry = materials::find_model(*model))
+      specs.insert(specs.end(), entry->parameters.begin(), entry->parameters.end());
+  return specs;
+}
+
+void read_material(const Teuchos::ParameterList& list, const std::string& name, const std::string& path, Reading& r) {
+  if (!list.isParameter("Model"))
+    throw parameter_error(r.file, path + "/Model", "missing (one of the registered models)");
+  Teuchos::ParameterList model_only;  // the model first: it decides the other parameters
+  model_only.setEntry("Model", list.getEntry("Model"));
+  (void)read_parameters(model_only, {model_spec()}, r.file, path);
+  ParameterValues values = read_parameters(list, material_specs(&list), r.file, path);
+  const materials::ModelEntry* entry = materials::find_model(values.string("Model"));
+  if (entry->check)
+    if (const auto problem = entry->check(values))
+      throw parameter_error(r.file, path + "/" + problem->parameter, problem->reason);
+  r.scene.materials.push_back({name, entry->model, entry, std::move(values)});
+}
+
+void read_solver(const Teuchos::ParameterList& list, const std::string&, const std::string& path, Reading& r) {
+  const auto solver = parse<SolverFileSettings>(list, path, r.file);
+  if (solver.file.empty()) return;  // the built-in default
+  const std::filesystem::path solver_path(solver.file);
+  r.scene.solver_file = solver_path.is_absolute()
+                            ? solver_path.string()
+                            : (std::filesystem::path(r.file).parent_path() / solver_path).lexically_normal().string();
+  if (!std::filesystem::is_regular_file(r.scene.solver_file))
+    throw parameter_error(r.file, "Solver/File", "cannot open '" + r.scene.solver_file + "'");
+}
+
+const std::vector<Section>& sections() {
+  static const std::vector<Section> list = {
+      {"Simulation", false, specs_of<SimulationSettings>,
+       [](const auto& l, const auto&, const auto& path, Reading& r) { r.scene.simulation = parse<SimulationSettings>(l, path, r.file); }},
+      {"Grid", false, specs_of<GridSettings>,
+       [](const auto& l, const auto&, const auto& path, Reading& r) { r.scene.grid = parse<GridSettings>(l, path, r.file); }},
+      {"Newton", false, specs_of<newton::NewtonSettings>,
+       [](const auto& l, const auto&, const auto& path, Reading& r) { r.scene.newton = parse<newton::NewtonSettings>(l, path, r.file); }},
+      {"Solver", false, specs_of<SolverFileSettings>, read_solver},
+      {"Output", false, specs_of<OutputSettings>,
+       [](const auto& l, const auto&, const auto& path, Reading& r) { r.scene.output = parse<OutputSettings>(l, path, r.file); }},
+      {"Materials", true, material_specs, read_material},
+      {"Bodies", true, specs_of<BodySettings>,
+       [](const auto& l, const auto& name, const auto& path, Reading& r) {
+         r.scene.bodies.push_back(parse<BodySettings>(l, path, r.file));
+         r.scene.bodies.back().name = name;
+       }},
+      {"Colliders", true, specs_of<ColliderSettings>,
+       [](const auto& l, const auto& name, const auto& path, Reading& r) {
+         r.scene.colliders.push_back(parse<ColliderSettings>(l, path, r.file));
+         r.scene.colliders.back().name = name;
+       }},
+      {"Emitters", true, specs_of<EmitterSettings>,
+       [](const auto& l, const auto& name, const auto& path, Reading& r) {
+         r.scene.emitters.push_back(parse<EmitterSettings>(l, path, r.file));
+         r.scene.emitters.back().name = name;
+       }},
+      {"Regions", true, specs_of<RegionSettings>,
+       [](const auto& l, const auto& name, const auto& path, Reading& r) {
+         r.scene.regions.push_back(parse<RegionSettings>(l, path, r.file));
+         r.scene.regions.back().name = name;
+       }},
+  };
+  return list;
+}
+
+const Section* find_section(const std::string& name) {
+  for (const auto& s : sections())
+    if (name == s.name) return &s;
+  return nullptr;
+}
+
+// Reads one section of `root` (an absent section: its defaults, or no items).
+void read_section(const Teuchos::ParameterList& root, const Section& section, Reading& r) {
+  const Teuchos::ParameterList empty;
+  const Teuchos::ParameterList& list = root.isSublist(section.name) ? root.sublist(section.name) : empty;
+  if (!section.per_item) {
+    section.read(list, section.name, section.name, r);
+    return;
+  }
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string path = std::string(section.name) + "/" + list.name(it);
+    if (!list.entry(it).isList()) throw parameter_error(r.file, path, "expected a sublist (one per item)");
+    section.read(Teuchos::getValue<Teuchos::ParameterList>(list.entry(it)), list.name(it), path, r);
+  }
+}
+
+std::vector<std::string> split_path(const std::string& path) {
+  std::vector<std::string> parts;
+  std::stringstream in(path);
+  for (std::string part; std::getline(in, part, '/');)
+    if (!part.empty()) parts.push_back(part);
+  return parts;
+}
+
+void apply_override(Teuchos::ParameterList& root, const Override& o, const std::string& file) {
+  const auto parts = split_path(o.path);
+  const Section* section = parts.empty() ? nullptr : find_section(parts[0]);
+  const std::size_t depth = section != nullptr && section->per_item ? 3 : 2;
+  std::vector<ParameterSpec> specs;
+  if (section != nullptr && parts.size() == depth) {
+    const Teuchos::ParameterList* item = nullptr;
+    if (depth == 3 && root.isSublist(parts[0]) && root.sublist(parts[0]).isSublist(parts[1]))
+      item = &root.sublist(parts[0]).sublist(parts[1]);
+    specs = section->specs(item);
+  }
+  const auto spec = std::find_if(specs.begin(), specs.end(), [&](const auto& s) { return s.name == parts.back(); });
+  if (spec == specs.end()) throw InputError(file + ": --set '" + o.path + "': unknown parameter");
+  Teuchos::ParameterList* target = &root;
+  for (std::size_t k = 0; k + 1 < parts.size(); ++k) target = &target->sublist(parts[k]);
+  try {
+    set_entry(*target, parts.back(), parse_value(*spec, o.value));
+  } catch (const InputError& e) {
+    throw InputError(file + ": --set '" + o.path + "': " + e.what());
+  }
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Names to indices.
+namespace {
+int material_index(const SceneConfig& scene, const std::string& name, const std::string& path) {
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].name == name) return static_cast<int>(m);
+  throw parameter_error(scene.file, path, "no material named '" + name + "'");
+}
+}  // namespace
+
+void link_names(SceneConfig& scene) {
+  for (auto& m : scene.materials) {
+    m.entry = materials::find_model(m.model);
+    if (m.entry == nullptr) throw parameter_error(scene.file, "Materials/" + m.name + "/Model", "unknown model '" + m.model + "'");
+  }
+  for (auto& b : scene.bodies) b.material_id = material_index(scene, b.material, "Bodies/" + b.name + "/Material");
+  for (auto& e : scene.emitters) e.material_id = material_index(scene, e.material, "Emitters/" + e.name + "/Material");
+  for (auto& r : scene.regions) {
+    const std::string path = "Regions/" + r.name;
+    r.material_id = material_index(scene, r.material, path + "/Material");
+    r.body_id = -1;
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+      if (scene.bodies[b].name == r.body) r.body_id = static_cast<int>(b);
+    if (r.body_id < 0) throw parameter_error(scene.file, path + "/Body", "no body named '" + r.body + "'");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shapes, and what is derived from Grid/Cell size once every override is applied.
+namespace {
+Shape::Kind shape_kind(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::box: return Shape::Kind::box;
+    case ShapeKind::sphere: return Shape::Kind::sphere;
+    case ShapeKind::cylinder: return Shape::Kind::cylinder;
+    case ShapeKind::disc: return Shape::Kind::cylinder;
+    case ShapeKind::half_space: return Shape::Kind::half_space;
+    case ShapeKind::mesh: return Shape::Kind::mesh;
+    case ShapeKind::cuts: return Shape::Kind::cuts;
+  }
+  return Shape::Kind::box;
+}
+
+Shape make_shape(const ShapeSettings& s, const std::string& file, const std::string& path) {
+  Shape shape;
+  shape.kind = shape_kind(s.shape);
+  shape.lower = s.lower_corner;
+  shape.upper = s.upper_corner;
+  shape.center = s.center;
+  shape.radius = s.radius;
+  shape.length = s.length;
+  shape.field = s.field;
+  shape.cut_count = s.cut_count;
+  shape.cut_width = s.cut_width;
+  if (shape.kind == Shape::Kind::mesh && !shape.field && !file.empty())
+    throw parameter_error(file, path + "/File", "no mesh loaded");
+  const Vec3 direction = shape.kind == Shape::Kind::half_space ? s.normal : s.axis;
+  if (direction.norm() == 0.0) throw parameter_error(file, path, "direction must be non-zero");
+  shape.axis = direction.normalized();
+  if (shape.kind == Shape::Kind::box && !(s.upper_corner.array() > s.lower_corner.array()).all())
+    throw parameter_error(file, path + "/Upper corner", "must exceed Lower corner in every component");
+  return shape;
+}
+
+double mesh_area(const geometry::TriangleMesh& mesh) {
+  double area = 0.0;
+  for (const auto& t : mesh.triangles)
+    area += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]).norm();
+  return area;
+}
+
+// Peak memory of OpenVDB's meshToLevelSet per voxel of its 6-voxel band (measured: 33-35 bytes,
+// the toothbrush of inputs/meshes at voxels of 2.5 to 0.625 mm, doc/contracts.md).
+constexpr double level_set_bytes_per_voxel = 40.0;
+// OpenVDB's voxel coordinates are 32-bit integers.
+constexpr double max_voxels_across = 1073741824.0;
+
+// A mesh's level set (of the placed mesh) must be one OpenVDB can build (its smallest voxel, its
+// coordinate range) and whose band fits in this machine's memory; the message names the
+// parameter that decides (Voxel size, or File for the default quarter cell; Scale or Center for
+// the range).
+void check_level_set(const geometry::TriangleMesh& mesh, double voxel, const ShapeSettings& s,
+                     const std::string& file, const std::string& path) {
+  std::ostringstream reason;
+  reason.precision(3);
+  Vec3 lo, hi;
+  mesh.bounding_box(lo, hi);
+  const double reach = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()) / voxel;
+  const double size = (hi - lo).maxCoeff() / voxel;
+  const double bytes = level_set_bytes_per_voxel * 6.0 * mesh_area(mesh) / (voxel * voxel);
+  const double memory = parallel::machine_memory();
+  std::string parameter = s.voxel_size > 0.0 ? "/Voxel size" : "/File";
+  if (voxel < min_voxel_size) {
+    reason << "voxels of " << voxel << " m are below the smallest OpenVDB takes (" << min_voxel_size << " m)";
+  } else if (reach > max_voxels_across) {
+    parameter = size > max_voxels_across ? "/Scale" : "/Center";
+    reason << "the placed mesh reaches " << reach << " voxels of " << voxel
+           << " m from the origin, more than OpenVDB can index (" << max_voxels_across << ")";
+  } else if (bytes > memory) {
+    reason << "its level set needs about " << bytes / 1073741824.0 << " GiB (" << level_set_bytes_per_voxel
+           << " bytes per voxel of its band), more than the " << memory / 1073741824.0 << " GiB of this machine";
+  } else {
+    return;
+  }
+  throw parameter_error(file, path + parameter, reason.str());
+}
+
+// Reads the mesh of a mesh shape, places it (Scale, Center) and builds its signed distance field;
+// a body or region needs a closed mesh (it has an inside).
+void load_mesh(ShapeSettings& s, const std::string& file, const std::string& path, double cell_size,
+               bool must_be_closed) {
+  if (s.shape != ShapeKind::mesh) return;
+  const std::string where = file + ": parameter '" + path + "/File': ";
+  if (s.mesh_file.empty()) throw InputError(where + "a mesh shape needs a file");
+  const std::filesystem::path mesh_path = std::filesystem::path(s.mesh_file).is_absolute()
+                                              ? std::filesystem::path(s.mesh_file)
+                                              : std::filesystem::path(file).parent_path() / s.mesh_file;
+  const std::string mesh_file = mesh_path.lexically_normal().string();
+  geometry::TriangleMesh mesh;
+  try {
+    mesh = geometry::transformed(geometry::read_mesh(mesh_file), s.mesh_scale, s.center);
+  } catch (const InputError& e) {
+    throw InputError(where + e.what());
+  }
+  for (const Vec3& v : mesh.vertices)
+    if (!v.allFinite())
+      throw InputError(where + mesh_file + ": a vertex placed at Scale·x + Center is not finite (" +
+                       number_text(s.mesh_scale) + " · x overflows)");
+  if (must_be_closed && !geometry::is_closed(mesh))
+    throw InputError(where + mesh_file + ": the mesh is not closed (every edge must join two consistently oriented triangles)");
+  const double voxel = s.voxel_size > 0.0 ? s.voxel_size : 0.25 * cell_size;
+  check_level_set(mesh, voxel, s, file, path);
+  s.field = std::make_shared<geometry::LevelSet>(mesh, voxel);
+}
+
+// Meshes' level sets (voxels default to a quarter cell) and disc nozzles (two cells along the
+// velocity): after every override, so that a changed cell size reaches them.
+void derive_from_cell_size(SceneConfig& scene) {
+  const double dx = scene.grid.cell_size;
+  for (auto& b : scene.bodies) load_mesh(b, scene.file, "Bodies/" + b.name, dx, true);
+  for (auto& c : scene.colliders) load_mesh(c, scene.file, "Colliders/" + c.name, dx, false);
+  for (auto& r : scene.regions) load_mesh(r, scene.file, "Regions/" + r.name, dx, true);
+  for (auto& e : scene.emitters)
+    if (e.shape == ShapeKind::disc) {
+      e.axis = e.velocity;
+      e.length = 2.0 * dx;
+    }
+}
+}  // namespace
+
+Shape shape_of(const ShapeSettings& s) { return make_shape(s, "", ""); }
+
+boundary::Collider collider_of(const ColliderSettings& c) {
+  boundary::Collider collider;
+  collider.name = c.name;
+  collider.shape = shape_of(c);
+  collider.type = c.contact;
+  collider.motion.velocity = c.velocity;
+  collider.motion.angular_velocity = c.angular_velocity;
+  collider.motion.center = c.rotation_center;
+  collider.motion.start_time = c.start_time;
+  collider.motion.stop_time = c.stop_time;
+  for (std::size_t k = 0; k < c.keyframe_times.size(); ++k) {
+    boundary::Keyframe key;
+    key.time = c.keyframe_times[k];
+    key.position = Vec3(c.keyframe_positions[3 * k], c.keyframe_positions[3 * k + 1], c.keyframe_positions[3 * k + 2]);
+    if (!c.keyframe_rotations.empty())
+      key.rotation = Vec3(c.keyframe_rotations[3 * k], c.keyframe_rotations[3 * k + 1], c.keyframe_rotations[3 * k + 2]);
+    collider.motion.keyframes.push_back(key);
+  }
+  collider.surface_velocity = c.surface_velocity;
+  return collider;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cross-parameter checks.
+namespace {
+// At most 2^53 grid nodes: their ids, and 3 per node for the Newton unknowns, stay exact in the
+// 64-bit integers (and doubles) that hold them.
+constexpr double max_grid_nodes = 9007199254740992.0;
+// Cell indices per dimension are ints.
+constexpr double max_cells_per_dimension = 1073741824.0;
+
+void check_grid_and_time_steps(const SceneConfig& scene) {
+  const std::string& file = scene.file;
+  const GridSettings& grid = scene.grid;
+  if (scene.bodies.empty() && scene.emitters.empty())
+    throw parameter_error(file, "Bodies", "the scene has no bodies (and no emitters)");
+  if (!(grid.upper_corner.array() > grid.lower_corner.array()).all())
+    throw parameter_error(file, "Grid/Upper corner", "must exceed Lower corner in every component");
+  const Vec3 extent = grid.upper_corner - grid.lower_corner;
+  if (!extent.allFinite()) throw parameter_error(file, "Grid/Upper corner", "the extent of the grid is not finite");
+  if (extent.minCoeff() < 2.0 * (grid.wall_thickness + 2) * grid.cell_size)
+    throw parameter_error(file, "Grid/Cell size", "the domain must be several cells wide in every direction");
+  if (scene.simulation.min_time_step > scene.simulation.max_time_step)
+    throw parameter_error(file, "Simulation/Min time step", "exceeds Max time step");
+  // Node ids are 64-bit integers and the Newton unknowns 3 per node: bound the grid before any
+  // arithmetic in integers (doubles here, so that nothing overflows).
+  double nodes = 1.0, widest = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    nodes *= std::ceil(extent[d] / grid.cell_size) + 1.0;
+    widest = std::max(widest, std::ceil(extent[d] / grid.cell_size));
+  }
+  if (nodes > max_grid_nodes || widest > max_cells_per_dimension) {
+    std::ostringstream reason;
+    reason << grid.cell_size << " m makes " << nodes << " grid nodes (" << widest
+           << " cells across), more than viscompm can number (" << max_grid_nodes << " nodes, "
+           << max_cells_per_dimension << " cells across)";
+    throw parameter_error(file, "Grid/Cell size", reason.str());
+  }
+  const double surface_voxel = scene.output.surface_voxel_size;
+  if (surface_voxel > 0.0 && surface_voxel < min_voxel_size)
+    throw parameter_error(file, "Output/Surface voxel size",
+                          "voxels of " + number_text(surface_voxel) + " m are below the smallest OpenVDB takes (" +
+                              number_text(min_voxel_size) + " m)");
+}
+
 void check_keyframes(const ColliderSettings& c, const std::string& file, const std::string& path) {
   const std::size_t n = c.keyframe_times.size();
   if (n == 0) {
     if (!c.keyframe_positions.empty() || !c.keyframe_rotations.empty())
-      throw InputError(file + ": parameter '" + path + "/Keyframe times': keyframes need their times");
+      throw parameter_error(file, path + "/Keyframe times", "keyframes need their times");
     return;
   }
   for (std::size_t k = 1; k < n; ++k)
     if (!(c.keyframe_times[k] > c.keyframe_times[k - 1]))
-      throw InputError(file + ": parameter '" + path + "/Keyframe times': must increase");
+      throw parameter_error(file, path + "/Keyframe times", "must increase");
   if (c.keyframe_positions.size() != 3 * n)
-    throw InputError(file + ": parameter '" + path + "/Keyframe positions': needs 3 numbers per keyframe time (" +
-                     std::to_string(3 * n) + "), got " + std::to_string(c.keyframe_positions.size()));
+    throw parameter_error(file, path + "/Keyframe positions",
+                          "needs 3 numbers per keyframe time (" + std::to_string(3 * n) + "), got " +
+                              std::to_string(c.keyframe_positions.size()));
   if (!c.keyframe_rotations.empty() && c.keyframe_rotations.size() != 3 * n)
-    throw InputError(file + ": parameter '" + path + "/Keyframe rotations': needs 3 numbers per keyframe time (" +
-                     std::to_string(3 * n) + "), got " + std::to_string(c.keyframe_rotations.size()));
+    throw parameter_error(file, path + "/Keyframe rotations",
+                          "needs 3 numbers per keyframe time (" + std::to_string(3 * n) + "), got " +
+                              std::to_string(c.keyframe_rotations.size()));
 }
 
-bool has_material(const SceneConfig& scene, const std::string& name) {
-  for (const auto& m : scene.materials)
-    if (m.name == name) return true;
-  return false;
-}
-
-void read_emitters_and_regions(const Teuchos::ParameterList& root, const std::string& file, SceneConfig& scene) {
-  for_each_item(root, "Emitters", file, [&](const std::string& name, const Teuchos::ParameterList& list,
-                                            const std::string& path) {
-    EmitterSettings e = EmitterSettings::table().parse(read_parameters(list, EmitterSettings::table().specs(), file, path));
-    e.name = name;
-    if (!has_material(scene, e.material))
-      throw InputError(file + ": parameter '" + path + "/Material': no material named '" + e.material + "'");
-    if (e.velocity.norm() == 0.0) throw InputError(file + ": parameter '" + path + "/Velocity': must be non-zero");
-    if (e.stop_time <= e.start_time) throw InputError(file + ": parameter '" + path + "/Stop time': must exceed Start time");
-    if (e.shape == "disc") {
-      // A disc: a cylinder two cells thick along the velocity, so that nodes lie inside it.
-      e.shape = "cylinder";
-      e.axis = e.velocity;
-      e.length = 2.0 * scene.grid.cell_size;
+// The fastest motion a scene prescribes, and the parameter that sets it.
+struct FastestMotion {
+  double speed = 0.0;
+  std::string parameter;
+  void consider(double s, const std::string& path) {
+    if (s > speed) {
+      speed = s;
+      parameter = path;
     }
+  }
+};
+
+// Half the diagonal of a bounded shape's box (0 for unbounded ones).
+double half_diagonal(const Shape& shape) {
+  Vec3 lo, hi;
+  shape.bounding_box(lo, hi);
+  return lo.allFinite() && hi.allFinite() ? 0.5 * (hi - lo).norm() : 0.0;
+}
+
+// The parameter of the largest of the terms a speed sums.
+std::string dominant(const std::vector<std::pair<double, std::string>>& terms) {
+  return std::max_element(terms.begin(), terms.end(), [](const auto& a, const auto& b) { return a.first < b.first; })->second;
+}
+
+FastestMotion fastest_motion(const SceneConfig& scene) {
+  FastestMotion fastest;
+  for (const auto& b : scene.bodies) {
+    const double v = b.velocity.norm(), w = b.angular_velocity.norm() * half_diagonal(shape_of(b));
+    fastest.consider(v + w, "Bodies/" + b.name + "/" + dominant({{v, "Velocity"}, {w, "Angular velocity"}}));
+  }
+  for (const auto& c : scene.colliders) {
+    const boundary::Collider collider = collider_of(c);
+    const double speed = collider.max_speed(), v = c.velocity.norm(), s = c.surface_velocity.norm();
+    const std::string parameter = !c.keyframe_times.empty()
+                                      ? "Keyframe positions"
+                                      : dominant({{v, "Velocity"}, {s, "Surface velocity"}, {speed - v - s, "Angular velocity"}});
+    fastest.consider(speed, "Colliders/" + c.name + "/" + parameter);
+  }
+  for (const auto& e : scene.emitters) fastest.consider(e.velocity.norm(), "Emitters/" + e.name + "/Velocity");
+  return fastest;
+}
+
+// Δt follows the fastest motion (CFL); below Min time step a run could not take a step.
+void check_speeds(const SceneConfig& scene) {
+  const FastestMotion fastest = fastest_motion(scene);
+  if (!(fastest.speed > 0.0)) return;
+  const double dt = scene.simulation.cfl * scene.grid.cell_size / fastest.speed;
+  if (std::isfinite(fastest.speed) && dt >= scene.simulation.min_time_step) return;
+  std::ostringstream reason;
+  reason.precision(3);
+  reason << "a speed of " << fastest.speed << " m/s needs steps of CFL·Δx/speed = " << dt
+         << " s, below Simulation/Min time step (" << scene.simulation.min_time_step << " s)";
+  throw parameter_error(scene.file, fastest.parameter, reason.str());
+}
+
+// The layer of a nozzle: the plane through its centre, normal to the velocity, inside it.
+void nozzle_extent(const EmitterSettings& e, Vec3& lo, Vec3& hi) {
+  const Shape nozzle = shape_of(e);
+  if (e.shape != ShapeKind::disc) {
+    nozzle.bounding_box(lo, hi);
+    return;
+  }
+  const Vec3 n = e.velocity.normalized();
+  const Vec3 half = e.radius * (Vec3::Ones() - n.cwiseProduct(n)).cwiseMax(0.0).cwiseSqrt();
+  lo = e.center - half;
+  hi = e.center + half;
+}
+
+// What needs no mesh: motions' times and keyframes, bounded bodies, emitters' velocities, times
+// and nozzles (inside the grid, off its last cells, where particles are held).
+void check_settings(const SceneConfig& scene) {
+  const std::string& file = scene.file;
+  const double dx = scene.grid.cell_size;
+  for (const auto& b : scene.bodies)
+    if (b.shape == ShapeKind::half_space) throw parameter_error(file, "Bodies/" + b.name + "/Shape", "a body must be bounded");
+  for (const auto& c : scene.colliders) {
+    const std::string path = "Colliders/" + c.name;
+    check_keyframes(c, file, path);
+    if (c.stop_time < c.start_time) throw parameter_error(file, path + "/Stop time", "must not precede Start time");
+  }
+  for (const auto& e : scene.emitters) {
+    const std::string path = "Emitters/" + e.name;
+    if (e.velocity.norm() == 0.0) throw parameter_error(file, path + "/Velocity", "must be non-zero");
+    if (e.stop_time <= e.start_time) throw parameter_error(file, path + "/Stop time", "must exceed Start time");
     make_shape(e, file, path);
-    scene.emitters.push_back(e);
-  });
-  for_each_item(root, "Regions", file, [&](const std::string& name, const Teuchos::ParameterList& list,
-                                           const std::string& path) {
-    RegionSettings r = RegionSettings::table().parse(read_parameters(list, RegionSettings::table().specs(), file, path));
-    r.name = name;
-    if (!has_material(scene, r.material))
-      throw InputError(file + ": parameter '" + path + "/Material': no material named '" + r.material + "'");
-    bool known = false;
-    for (const auto& b : scene.bodies) known |= b.name == r.body;
-    if (!known) throw InputError(file + ": parameter '" + path + "/Body': no body named '" + r.body + "'");
-    load_mesh(r, file, path, scene.grid.cell_size, true);
-    make_shape(r, file, path);
-    scene.regions.push_back(r);
-  });
+    Vec3 lo, hi;
+    nozzle_extent(e, lo, hi);
+    const Vec3 inner_lo = scene.grid.lower_corner.array() + dx, inner_hi = scene.grid.upper_corner.array() - dx;
+    if ((lo.array() < inner_lo.array()).any() || (hi.array() > inner_hi.array()).any())
+      throw parameter_error(file, path + "/Center",
+                            "the nozzle reaches outside the grid (its layers must lie at least one cell inside it)");
+  }
+}
+
+// The shapes (meshes loaded) and the speeds they move at.
+void check_shapes_and_speeds(const SceneConfig& scene) {
+  for (const auto& b : scene.bodies) make_shape(b, scene.file, "Bodies/" + b.name);
+  for (const auto& c : scene.colliders) make_shape(c, scene.file, "Colliders/" + c.name);
+  for (const auto& r : scene.regions) make_shape(r, scene.file, "Regions/" + r.name);
+  check_speeds(scene);
 }
 }  // namespace
 
@@ -419,87 +754,23 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   SceneConfig scene;
   scene.file = file;
   scene.name = std::filesystem::path(file).stem().string();
-  check_entries(*root, {}, std::vector<std::string>(std::begin(section_names), std::end(section_names)), file, "");
-  scene.simulation = read_section<SimulationSettings>(*root, "Simulation", file);
-  scene.grid = read_section<GridSettings>(*root, "Grid", file);
-  scene.newton = read_section<newton::NewtonSettings>(*root, "Newton", file);
-  scene.output = read_section<OutputSettings>(*root, "Output", file);
-  const auto solver = read_section<SolverFileSettings>(*root, "Solver", file);
-  const std::filesystem::path solver_path(solver.file);
-  scene.solver_file = solver_path.is_absolute()
-                          ? solver_path.string()
-                          : (std::filesystem::path(file).parent_path() / solver_path).lexically_normal().string();
-  if (!std::filesystem::is_regular_file(scene.solver_file))
-    throw InputError(file + ": parameter 'Solver/File': cannot open '" + scene.solver_file + "'");
-
-  for_each_item(*root, "Materials", file, [&](const std::string& name, const Teuchos::ParameterList& list,
-                                              const std::string& path) {
-    if (!list.isParameter("Model"))
-      throw InputError(file + ": parameter '" + path + "/Model': missing (one of the registered models)");
-    Teuchos::ParameterList model_only;  // the model first: it decides the other parameters
-    model_only.setEntry("Model", list.getEntry("Model"));
-    const ParameterValues model_value = read_parameters(model_only, {model_spec()}, file, path);
-    const auto* entry = materials::find_model(model_value.string("Model"));
-    std::vector<ParameterSpec> specs = {model_spec()};
-    specs.insert(specs.end(), entry->parameters.begin(), entry->parameters.end());
-    ParameterValues values = read_parameters(list, specs, file, path);
-    if (entry->check)
-      if (const auto problem = entry->check(values))
-        throw InputError(file + ": parameter '" + path + "/" + problem->parameter + "': " + problem->reason);
-    scene.materials.push_back({name, entry->model, std::move(values)});
-  });
-  for_each_item(*root, "Bodies", file, [&](const std::string& name, const Teuchos::ParameterList& list,
-                                           const std::string& path) {
-    BodySettings body = BodySettings::table().parse(read_parameters(list, BodySettings::table().specs(), file, path));
-    body.name = name;
-    bool known = false;
-    for (const auto& m : scene.materials) known |= m.name == body.material;
-    if (!known) throw InputError(file + ": parameter '" + path + "/Material': no material named '" + body.material + "'");
-    if (body.shape == "half_space") throw InputError(file + ": parameter '" + path + "/Shape': a body must be bounded");
-    load_mesh(body, file, path, scene.grid.cell_size, true);
-    make_shape(body, file, path);
-    scene.bodies.push_back(body);
-  });
-  for_each_item(*root, "Colliders", file, [&](const std::string& name, const Teuchos::ParameterList& list,
-                                              const std::string& path) {
-    ColliderSettings collider =
-        ColliderSettings::table().parse(read_parameters(list, ColliderSettings::table().specs(), file, path));
-    collider.name = name;
-    load_mesh(collider, file, path, scene.grid.cell_size, false);
-    make_shape(collider, file, path);
-    check_keyframes(collider, file, path);
-    scene.colliders.push_back(collider);
-  });
-  read_emitters_and_regions(*root, file, scene);
-
-  // Cross-parameter checks.
-  if (scene.bodies.empty() && scene.emitters.empty())
-    throw InputError(file + ": parameter 'Bodies': the scene has no bodies (and no emitters)");
-  if (!(scene.grid.upper_corner.array() > scene.grid.lower_corner.array()).all())
-    throw InputError(file + ": parameter 'Grid/Upper corner': must exceed Lower corner in every component");
-  const Vec3 extent = scene.grid.upper_corner - scene.grid.lower_corner;
-  if (extent.minCoeff() < 2.0 * (scene.grid.wall_thickness + 2) * scene.grid.cell_size)
-    throw InputError(file + ": parameter 'Grid/Cell size': the domain must be several cells wide in every direction");
-  if (scene.simulation.min_time_step > scene.simulation.max_time_step)
-    throw InputError(file + ": parameter 'Simulation/Min time step': exceeds Max time step");
-  // Node ids are 64-bit integers and the Newton unknowns 3 per node: bound the grid before any
-  // arithmetic in integers (doubles here, so that nothing overflows).
-  double nodes = 1.0, widest = 0.0;
-  for (int d = 0; d < 3; ++d) {
-    nodes *= std::ceil(extent[d] / scene.grid.cell_size) + 1.0;
-    widest = std::max(widest, std::ceil(extent[d] / scene.grid.cell_size));
-  }
-  if (nodes > max_grid_nodes || widest > max_cells_per_dimension) {
-    std::ostringstream reason;
-    reason << file << ": parameter 'Grid/Cell size': " << scene.grid.cell_size << " m makes " << nodes
-           << " grid nodes (" << widest << " cells across), more than viscompm can number (" << max_grid_nodes
-           << " nodes, " << max_cells_per_dimension << " cells across)";
-    throw InputError(reason.str());
-  }
+  std::vector<std::string> names;
+  for (const auto& s : sections()) names.push_back(s.name);
+  check_entries(*root, {}, names, file, "");
+  Reading reading{file, scene};
+  for (const auto& s : sections()) read_section(*root, s, reading);
+  link_names(scene);
+  check_grid_and_time_steps(scene);
+  check_settings(scene);
+  derive_from_cell_size(scene);  // meshes: the only part of reading that may take long
+  check_shapes_and_speeds(scene);
   return scene;
 }
 
-Shape shape_of(const ShapeSettings& s) { return make_shape(s, "", ""); }
+linalg::SolverConfiguration solver_configuration(const SceneConfig& scene) {
+  if (!scene.solver_file.empty()) return linalg::SolverConfiguration::read(scene.solver_file);
+  return linalg::SolverConfiguration::from_xml(default_solver_xml, "built-in default solver (inputs/solvers/jacobi_cg.xml)");
+}
 
 std::string describe_scene_parameters() {
   std::ostringstream out;
@@ -509,15 +780,10 @@ std::string describe_scene_parameters() {
       out << "    " << s.name << " (" << ParameterSpec::type_name(s.type) << ", " << s.range_text() << "): " << s.doc
           << "\n";
   };
-  section("Simulation", SimulationSettings::table().specs());
-  section("Grid", GridSettings::table().specs());
-  section("Newton", newton::NewtonSettings::table().specs());
-  section("Solver", SolverFileSettings::table().specs());
-  section("Output", OutputSettings::table().specs());
-  section("Bodies/<name>", BodySettings::table().specs());
-  section("Colliders/<name>", ColliderSettings::table().specs());
-  section("Emitters/<name>", EmitterSettings::table().specs());
-  section("Regions/<name>", RegionSettings::table().specs());
+  for (const auto& s : sections()) {
+    if (std::string(s.name) == "Materials") continue;  // per model, below
+    section(std::string(s.name) + (s.per_item ? "/<name>" : ""), s.specs(nullptr));
+  }
   for (const auto& m : materials::model_registry())
     section("Materials/<name> with Model = " + m.model + " (" + m.summary + ")", m.parameters);
   return out.str();

@@ -5,37 +5,9 @@
 
 namespace viscompm::simulation {
 
-namespace {
-int material_index(const materials::MaterialList& materials, const std::string& name) {
-  for (std::size_t m = 0; m < materials.size(); ++m)
-    if (materials[m]->name() == name) return static_cast<int>(m);
-  throw InputError("no material named '" + name + "'");
-}
-}  // namespace
-
 std::vector<boundary::Collider> make_colliders(const scene::SceneConfig& scene) {
   std::vector<boundary::Collider> colliders;
-  for (const auto& c : scene.colliders) {
-    boundary::Collider collider;
-    collider.name = c.name;
-    collider.shape = scene::shape_of(c);
-    collider.type = boundary::contact_type_from_name(c.contact);
-    collider.motion.velocity = c.velocity;
-    collider.motion.angular_velocity = c.angular_velocity;
-    collider.motion.center = c.rotation_center;
-    collider.motion.start_time = c.start_time;
-    collider.motion.stop_time = c.stop_time;
-    for (std::size_t k = 0; k < c.keyframe_times.size(); ++k) {
-      boundary::Keyframe key;
-      key.time = c.keyframe_times[k];
-      key.position = Vec3(c.keyframe_positions[3 * k], c.keyframe_positions[3 * k + 1], c.keyframe_positions[3 * k + 2]);
-      if (!c.keyframe_rotations.empty())
-        key.rotation = Vec3(c.keyframe_rotations[3 * k], c.keyframe_rotations[3 * k + 1], c.keyframe_rotations[3 * k + 2]);
-      collider.motion.keyframes.push_back(key);
-    }
-    collider.surface_velocity = c.surface_velocity;
-    colliders.push_back(collider);
-  }
+  for (const auto& c : scene.colliders) colliders.push_back(scene::collider_of(c));
   return colliders;
 }
 
@@ -61,11 +33,10 @@ std::vector<particles::Emitter> make_emitters(const scene::SceneConfig& scene, c
     spec.start_time = e.start_time;
     spec.stop_time = e.stop_time;
     spec.particles_per_cell = e.particles_per_cell;
-    spec.material_id = material_index(materials, e.material);
+    spec.material_id = e.material_id;
     spec.density = materials[spec.material_id]->density();
     const std::size_t sites = particles::nozzle_sites(spec.nozzle, spec.velocity, grid.dx / e.particles_per_cell).size();
-    if (sites == 0)
-      throw InputError(scene.file + ": parameter 'Emitters/" + e.name + "/Shape': the nozzle holds no particle site");
+    if (sites == 0) throw parameter_error(scene.file, "Emitters/" + e.name + "/Shape", "the nozzle holds no particle site");
     offsets.push_back(stride);
     stride += static_cast<ParticleId>(sites);
     specs.push_back(spec);
@@ -81,14 +52,14 @@ std::vector<boundary::Inflow> make_inflows(const scene::SceneConfig& scene) {
   return inflows;
 }
 
-std::vector<particles::MaterialRegion> make_regions(const scene::SceneConfig& scene, const std::string& body_name,
+std::vector<particles::MaterialRegion> make_regions(const scene::SceneConfig& scene, int body,
                                                     const materials::MaterialList& materials) {
   std::vector<particles::MaterialRegion> regions;
   for (const auto& r : scene.regions) {
-    if (r.body != body_name) continue;
+    if (r.body_id != body) continue;
     particles::MaterialRegion region;
     region.shape = scene::shape_of(r);
-    region.material_id = material_index(materials, r.material);
+    region.material_id = r.material_id;
     region.density = materials[region.material_id]->density();
     regions.push_back(region);
   }

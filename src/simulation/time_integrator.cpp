@@ -3,6 +3,8 @@
 #include <Teuchos_TimeMonitor.hpp>
 
 #include <cmath>
+#include <type_traits>
+#include <utility>
 
 #include "viscompm/parallel/ghost_particles.hpp"
 #include "viscompm/parallel/migration.hpp"
@@ -30,7 +32,8 @@ TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::G
   layout_.order = order;
 }
 
-StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, double dt, const std::string& dump_prefix) {
+StepReport TimeIntegrator::step(particles::ParticleSet& own_particles, double t, double dt,
+                                 const std::string& dump_prefix) {
   static const auto layout_timer = timer("viscompm: 1 layout");
   static const auto p2g_timer = timer("viscompm: 2 p2g");
   static const auto newton_timer = timer("viscompm: 3 newton");
@@ -38,6 +41,8 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
   static const auto advect_timer = timer("viscompm: 5 advect");
   StepReport report;
   report.dt = dt;
+  particles::ParticleSet& particles = working_;
+  particles = own_particles;  // the caller's set changes only if the step is taken
   {
     Teuchos::TimeMonitor m(*layout_timer);
     report.partition_rebuilt = build_layout(particles, dt);
@@ -61,7 +66,11 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
     report.newton = newton_.solve(*objective->potential, v, dump);
   }
   drop_ghosts(particles);
-  if (!report.newton.converged) return report;
+  if (report.newton.interrupted) return report;
+  if (!report.newton.converged) {
+    report.failure = "Newton failed (" + report.newton.failure + ")";
+    return report;
+  }
   {
     Teuchos::TimeMonitor m(*g2p_timer);
     grid_to_particles(particles, v, dt);
@@ -72,7 +81,26 @@ StepReport TimeIntegrator::step(particles::ParticleSet& particles, double t, dou
     Teuchos::TimeMonitor m(*advect_timer);
     advect(particles, dt, report);
   }
+  if (!finite(particles)) {
+    report.failure = "the step produced non-finite particle values";
+    return report;
+  }
+  std::swap(own_particles, working_);
+  report.taken = true;
   return report;
+}
+
+bool TimeIntegrator::finite(const particles::ParticleSet& particles) const {
+  bool finite = true;
+  particles.for_each_field([&](const char*, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    if constexpr (std::is_same_v<T, Vec3> || std::is_same_v<T, Mat3>) {
+      for (const auto& value : field) finite &= value.allFinite();
+    } else if constexpr (std::is_same_v<T, double>) {
+      for (double value : field) finite &= std::isfinite(value);
+    }
+  });
+  return !comm_.any(!finite);
 }
 
 std::unique_ptr<StepObjective> TimeIntegrator::build_objective(const particles::ParticleSet& particles, double t,

@@ -1,17 +1,19 @@
 #include "viscompm/study/solver_study.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <memory>
 #include <ostream>
 #include <random>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/matrix_market.hpp"
-#include "viscompm/scene/parameter_io.hpp"
+#include "viscompm/params/parameter_io.hpp"
 #include "viscompm/simulation/simulation.hpp"
 
 namespace viscompm::study {
@@ -20,16 +22,20 @@ const ParameterTable<StudySettings>& StudySettings::table() {
   static const ParameterTable<StudySettings> t = [] {
     ParameterTable<StudySettings> table;
     using S = StudySettings;
-    table.string(&S::mode, "Mode", "systems", {"systems", "steps"},
+    table.choice(&S::mode, "Mode", StudyMode::systems, {{"systems", StudyMode::systems}, {"steps", StudyMode::steps}},
                  "systems: the same Newton systems under every solver; steps: whole frames of the scene per configuration")
         .string(&S::scene, "Scene", "", {}, "scene whose Newton systems or frames are studied, relative to this file")
-        .real_list(&S::cell_sizes, "Cell sizes", {}, Range::positive(), "systems: resolutions Δx [m], one problem each")
+        .real_list(&S::cell_sizes, "Cell sizes", {}, Range::positive(),
+                   "systems: resolutions Δx [m], one problem each; steps: run every configuration at each (none: the "
+                   "scene's own)")
         .real_list(&S::time_steps, "Time steps", {10.0}, Range::positive(), "systems: Δt of the step, in Time step unit")
-        .string(&S::time_step_unit, "Time step unit", "elastic CFL", {"elastic CFL", "seconds"},
+        .choice(&S::time_step_unit, "Time step unit", TimeStepUnit::elastic_cfl,
+                {{"elastic CFL", TimeStepUnit::elastic_cfl}, {"seconds", TimeStepUnit::seconds}},
                 "elastic CFL: multiples of Δx/c with c = √((λ+2μ)/ρ) of the stiffest material")
         .real(&S::time, "Time", 0.0, Range::non_negative(),
               "systems: advance the scene to this time before taking the system [s]")
-        .string(&S::right_hand_side, "Right-hand side", "newton", {"newton", "random"},
+        .choice(&S::right_hand_side, "Right-hand side", RightHandSide::newton,
+                {{"newton", RightHandSide::newton}, {"random", RightHandSide::random}},
                 "systems: newton: the step's −∇E; random: m_i times uniform(−1, 1) per dof, seeded by node "
                 "(rank-independent)")
         .string_list(&S::solvers, "Solvers", {}, "solver XML files, relative to this file")
@@ -62,9 +68,18 @@ struct ConfigurationSettings {
   }
 };
 
+
 std::string relative_to(const std::string& file, const std::string& path) {
   const std::filesystem::path p(path);
   return p.is_absolute() ? path : (std::filesystem::path(file).parent_path() / p).lexically_normal().string();
+}
+
+// A file the study names at `parameter`, resolved against the study file; it must exist.
+std::string study_input(const std::string& study_file, const std::string& parameter, const std::string& path) {
+  const std::string resolved = relative_to(study_file, path);
+  if (!std::filesystem::is_regular_file(resolved))
+    throw parameter_error(study_file, parameter, "cannot open '" + resolved + "'");
+  return resolved;
 }
 
 std::string number(double x) {
@@ -73,8 +88,53 @@ std::string number(double x) {
   return s.str();
 }
 
+// A value as --set text that reads back as the same double.
+std::string exact(double x) {
+  std::ostringstream s;
+  s << std::setprecision(17) << x;
+  return s.str();
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The scene of a systems study at cell size h: the cell size as an override, so that what
+// derives from it (meshes' voxels, disc nozzles, the size checks) follows.
+scene::SceneConfig scene_at(const StudySettings& settings, double h) {
+  return scene::read_scene(settings.scene, {{"Grid/Cell size", exact(h)}});
+}
+
+// The scene of a steps configuration: the study's scene overrides, the cell size h (0: as they
+// leave it), then the configuration's Newton overrides.
+scene::SceneConfig scene_for(const StudySettings& settings, const StudySettings::Configuration& configuration,
+                             double h) {
+  std::vector<scene::Override> overrides;
+  for (const auto& o : settings.scene_overrides) overrides.push_back(scene::Override::parse(o));
+  if (h > 0.0) overrides.push_back({"Grid/Cell size", exact(h)});
+  for (const auto& o : configuration.newton) {
+    scene::Override newton = scene::Override::parse(o);
+    newton.path = "Newton/" + newton.path;
+    overrides.push_back(newton);
+  }
+  return scene::read_scene(settings.scene, overrides);
+}
+
+// The output directory, created on rank 0; every rank learns whether it could be.
+void create_output_directory(const StudySettings& settings, const std::string& study_file,
+                             const parallel::Communicator& comm) {
+  std::error_code error;
+  if (comm.is_root()) std::filesystem::create_directories(settings.output_directory, error);
+  if (comm.any(comm.is_root() && (error || !std::filesystem::is_directory(settings.output_directory))))
+    throw parameter_error(study_file, "Output directory", "cannot create '" + settings.output_directory + "'");
+}
+
+// Opens DIR/NAME on rank 0 for writing (truncating it); every rank learns whether it could.
+void open_csv(std::ofstream& out, const std::string& directory, const std::string& name, const std::string& study_file,
+              const parallel::Communicator& comm) {
+  if (comm.is_root()) out.open(std::filesystem::path(directory) / name);
+  if (comm.any(comm.is_root() && !out))
+    throw parameter_error(study_file, "Output directory", "cannot write " + name + " in '" + directory + "'");
 }
 
 struct Row {
@@ -86,11 +146,11 @@ struct Row {
 
 class Writer {
  public:
-  Writer(const std::string& directory, bool root, int ranks) : root_(root), ranks_(ranks) {
+  Writer(const std::string& directory, const std::string& study_file, const parallel::Communicator& comm)
+      : root_(comm.is_root()), ranks_(comm.size()) {
+    open_csv(study_, directory, "study.csv", study_file, comm);
+    open_csv(operators_, directory, "operators.csv", study_file, comm);
     if (!root_) return;
-    study_.open(std::filesystem::path(directory) / "study.csv");
-    operators_.open(std::filesystem::path(directory) / "operators.csv");
-    if (!study_ || !operators_) throw InputError("cannot write to " + directory);
     study_ << "problem,resolution,dofs,nonzeros,ranks,preconditioner,setup_seconds,solve_seconds,iterations,"
               "relative_residual,converged,operator_seconds\n";
     operators_ << "problem,resolution,dofs,ranks,preconditioner,operator,assembly_seconds,apply_seconds\n";
@@ -129,24 +189,91 @@ void log_row(std::ostream& log, const Row& row) {
   if (!r.failure.empty()) log << "  " << r.failure.substr(0, r.failure.find('\n')) << std::endl;
 }
 
-// The first Newton system of a scene at each cell size and Δt, under every configuration. Each
-// configuration prepares its own operator (assembly or matrix-free set-up), timed.
-void study_scene_systems(const StudySettings& settings, const std::string& study_file,
-                         const std::vector<linalg::SolverConfiguration>& configs, const parallel::Communicator& comm,
+// What a systems study reads, all of it before any output file is opened.
+struct SystemsInputs {
+  std::vector<scene::SceneConfig> scenes;  ///< one per cell size
+  std::vector<linalg::SolverConfiguration> configs;
+  std::vector<std::unique_ptr<linalg::MatrixMarketProblem>> problems;
+};
+
+SystemsInputs read_systems_inputs(const StudySettings& settings, const parallel::Communicator& comm) {
+  SystemsInputs inputs;
+  for (const auto& s : settings.solvers) inputs.configs.push_back(linalg::SolverConfiguration::read(s));
+  if (!settings.scene.empty())
+    for (double h : settings.cell_sizes) {
+      inputs.scenes.push_back(scene_at(settings, h));
+      simulation::check_memory(inputs.scenes.back(), comm);
+    }
+  for (const auto& file : settings.matrix_market_files)
+    inputs.problems.push_back(std::make_unique<linalg::MatrixMarketProblem>(file, comm));
+  return inputs;
+}
+
+// One configuration on the step's system: its own operator (assembly or matrix-free set-up),
+// preconditioner and solve, the fastest of the repetitions; a failed set-up is a row with
+// converged = 0.
+void solve_scene_system(const StudySettings& settings, const linalg::SolverConfiguration& config,
+                        simulation::TimeIntegrator& integrator, const simulation::StepObjective& objective,
+                        const NodeVectorField& rhs, Row& row, Writer& writer, const parallel::Communicator& comm,
+                        std::ostream& log) {
+  linalg::NewtonSystem system(integrator.node_space(), config);
+  row.dofs = system.global_rows();
+  double apply = 0.0;
+  linalg::LinearSolveReport best;
+  const auto total = [](const linalg::LinearSolveReport& r) { return r.operator_seconds + r.setup_seconds + r.solve_seconds; };
+  try {
+    for (int k = 0; k < settings.repetitions; ++k) {
+      const double operator_seconds = system.assemble(*objective.potential, objective.initial_guess, true);
+      const double setup_seconds = system.precondition();
+      NodeVectorField dv;
+      auto report = system.solve(rhs, dv);
+      report.operator_seconds = operator_seconds;
+      report.setup_seconds = setup_seconds;
+      if (k == 0 || total(report) < total(best)) best = report;
+    }
+    apply = system.time_apply(5);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    best = linalg::LinearSolveReport{};
+    best.preconditioner = config.label();
+    if (comm.is_root()) log << "  " << config.label() << " failed: " << e.what() << "\n";
+  }
+  if (!system.matrix_free()) row.nonzeros = system.global_nonzeros();
+  row.report = best;
+  writer.row(row);
+  writer.operator_row(row, system.matrix_free() ? "matrix-free" : "assembled", apply);
+  if (comm.is_root()) log_row(log, row);
+}
+
+// The right-hand side of the step's system: −∇E, or m_i times uniform(−1, 1) per dof seeded by
+// the node (rank-independent). False if the initial guess is infeasible (no system).
+bool right_hand_side(const StudySettings& settings, simulation::TimeIntegrator& integrator,
+                     const simulation::StepObjective& objective, NodeVectorField& rhs) {
+  if (!integrator.first_right_hand_side(objective, rhs)) return false;
+  if (settings.right_hand_side != RightHandSide::random) return true;
+  const auto& layout = integrator.layout();
+  for (std::size_t i = 0; i < layout.owned_count; ++i) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(layout.nodes[i]));
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    rhs[i] = objective.constraints.projection[i] * (integrator.grid_mass()[i] * Vec3(u(rng), u(rng), u(rng)));
+  }
+  return true;
+}
+
+// The first Newton system of a scene at each cell size and Δt, under every configuration.
+void study_scene_systems(const StudySettings& settings, const SystemsInputs& inputs, const parallel::Communicator& comm,
                          Writer& writer, std::ostream& log) {
-  const scene::SceneConfig base = scene::read_scene(relative_to(study_file, settings.scene));
-  for (double h : settings.cell_sizes) {
-    scene::SceneConfig scene = base;
-    scene.grid.cell_size = h;
+  for (const scene::SceneConfig& scene : inputs.scenes) {
     // Advance with the scene's own solver, then take the step's Newton system at several Δt.
-    simulation::Simulation sim(scene, linalg::SolverConfiguration::read(scene.solver_file), comm);
+    simulation::Simulation sim(scene, scene::solver_configuration(scene), comm);
     if (settings.time > 0.0) {
       simulation::RunSummary summary;
       sim.advance_to(settings.time, summary);
     }
     double wave_speed = 0.0;
     for (const auto& m : sim.materials()) wave_speed = std::max(wave_speed, m->wave_speed());
-    const bool cfl = settings.time_step_unit == "elastic CFL";
+    const bool cfl = settings.time_step_unit == TimeStepUnit::elastic_cfl;
     auto seconds = [&](double step) { return cfl ? step * sim.grid().dx / wave_speed : step; };
     double largest_step = 0.0;
     for (double step : settings.time_steps) largest_step = std::max(largest_step, seconds(step));
@@ -155,74 +282,34 @@ void study_scene_systems(const StudySettings& settings, const std::string& study
     for (double step : settings.time_steps) {
       const auto objective = integrator.build_objective(sim.particles(), sim.time(), seconds(step));
       Row row;
-      row.problem = base.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
-      row.resolution = h;
+      row.problem = scene.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
+      row.resolution = scene.grid.cell_size;
+      row.nonzeros = -1;
       NodeVectorField rhs;
-      if (!integrator.first_right_hand_side(*objective, rhs)) {
+      if (!right_hand_side(settings, integrator, *objective, rhs)) {
         // No Newton system here: every configuration gets a failed row.
-        if (comm.is_root()) log << row.problem << " dx=" << h << ": infeasible initial guess, no system\n";
-        for (const auto& config : configs) {
+        if (comm.is_root()) log << row.problem << " dx=" << row.resolution << ": infeasible initial guess, no system\n";
+        for (const auto& config : inputs.configs) {
           row.report = linalg::LinearSolveReport{};
           row.report.preconditioner = config.label();
           writer.row(row);
         }
         continue;
       }
-      const auto& layout = integrator.layout();
-      if (settings.right_hand_side == "random")
-        for (std::size_t i = 0; i < layout.owned_count; ++i) {
-          std::mt19937_64 rng(static_cast<std::uint64_t>(layout.nodes[i]));
-          std::uniform_real_distribution<double> u(-1.0, 1.0);
-          rhs[i] = objective->constraints.projection[i] * (integrator.grid_mass()[i] * Vec3(u(rng), u(rng), u(rng)));
-        }
-      std::int64_t nonzeros = -1;
-      for (const auto& config : configs) {
-        linalg::NewtonSystem system(integrator.node_space(), config);
-        row.dofs = system.global_rows();
-        double apply = 0.0;
-        linalg::LinearSolveReport best;
-        try {
-          for (int k = 0; k < settings.repetitions; ++k) {
-            const double operator_seconds = system.assemble(*objective->potential, objective->initial_guess, true);
-            const double setup_seconds = system.precondition();
-            NodeVectorField dv;
-            auto report = system.solve(rhs, dv);
-            report.operator_seconds = operator_seconds;
-            report.setup_seconds = setup_seconds;
-            const auto total = [](const linalg::LinearSolveReport& r) {
-              return r.operator_seconds + r.setup_seconds + r.solve_seconds;
-            };
-            if (k == 0 || total(report) < total(best)) best = report;
-          }
-          apply = system.time_apply(5);
-        } catch (const InputError&) {
-          throw;
-        } catch (const std::exception& e) {
-          best = linalg::LinearSolveReport{};  // a failed set-up is a row with converged = 0
-          best.preconditioner = config.label();
-          if (comm.is_root()) log << "  " << config.label() << " failed: " << e.what() << "\n";
-        }
-        if (!system.matrix_free()) nonzeros = system.global_nonzeros();
-        row.nonzeros = nonzeros;
-        row.report = best;
-        writer.row(row);
-        writer.operator_row(row, system.matrix_free() ? "matrix-free" : "assembled", apply);
-        if (comm.is_root()) log_row(log, row);
-      }
+      for (const auto& config : inputs.configs)
+        solve_scene_system(settings, config, integrator, *objective, rhs, row, writer, comm, log);
     }
   }
 }
 
-void study_matrix_market(const StudySettings& settings, const std::string& study_file,
-                         const std::vector<linalg::SolverConfiguration>& configs, const parallel::Communicator& comm,
-                         Writer& writer, std::ostream& log) {
-  for (const auto& file : settings.matrix_market_files) {
-    const std::string path = relative_to(study_file, file);
-    const linalg::MatrixMarketProblem problem(path, comm);
-    for (const auto& config : configs) {
+void study_matrix_market(const SystemsInputs& inputs, const StudySettings& settings,
+                         const parallel::Communicator& comm, Writer& writer, std::ostream& log) {
+  for (std::size_t k = 0; k < inputs.problems.size(); ++k) {
+    const linalg::MatrixMarketProblem& problem = *inputs.problems[k];
+    for (const auto& config : inputs.configs) {
       if (config.matrix_free()) continue;  // a matrix-free operator needs the scene's particles
       Row row;
-      row.problem = std::filesystem::path(path).stem().string();
+      row.problem = std::filesystem::path(settings.matrix_market_files[k]).stem().string();
       row.dofs = problem.rows();
       row.nonzeros = problem.nonzeros();
       linalg::MatrixMarketSolve solved;
@@ -242,135 +329,142 @@ void study_matrix_market(const StudySettings& settings, const std::string& study
   }
 }
 
-// Whole frames of the scene under each configuration: steps.csv, one row per configuration.
+// One row of steps.csv: the configuration's frames, its counts and where the time went (the
+// slowest rank's phase times).
+void write_steps_row(std::ofstream& out, const StudySettings& settings, const StudySettings::Configuration& configuration,
+                     double cell_size, const simulation::RunSummary& summary, double wall,
+                     const parallel::Communicator& comm) {
+  const double operator_seconds = comm.max(summary.operator_seconds);
+  const double setup_seconds = comm.max(summary.preconditioner_seconds);
+  const double cg_seconds = comm.max(summary.cg_seconds);
+  const double line_search_seconds = comm.max(summary.line_search_seconds);
+  if (!comm.is_root()) return;
+  out << '"' << configuration.label << "\",\"" << std::filesystem::path(configuration.solver).filename().string()
+      << "\"," << settings.frames << ',' << summary.steps << ',' << summary.newton_iterations << ','
+      << summary.linear_iterations << ',' << summary.assemblies << ',' << summary.preconditioner_setups << ','
+      << summary.graph_builds << ',' << summary.retries << ',' << wall << ',' << wall / settings.frames << ','
+      << operator_seconds << ',' << setup_seconds << ',' << cg_seconds << ',' << line_search_seconds << ','
+      << comm.size() << ',' << cell_size << '\n';
+  out.flush();
+}
+
+// Whole frames of the scene under each configuration (at each cell size): steps.csv, one row per run.
 int study_steps(const StudySettings& settings, const std::string& study_file, const parallel::Communicator& comm,
                 std::ostream& log) {
-  std::ofstream out;
-  if (comm.is_root()) {
-    out.open(std::filesystem::path(settings.output_directory) / "steps.csv");
-    if (!out) throw InputError(study_file + ": parameter 'Output directory': cannot write steps.csv there");
-    out << std::setprecision(9);
-    out << "configuration,solver,frames,steps,newton_iterations,cg_iterations,assemblies,preconditioner_setups,"
-           "graph_builds,retries,wall_seconds,seconds_per_frame,operator_seconds,preconditioner_seconds,cg_seconds,"
-           "line_search_seconds,ranks\n";
-  }
-  int rows = 0;
-  for (const auto& configuration : settings.configurations) {
-    std::vector<scene::Override> overrides;
-    for (const auto& o : settings.scene_overrides) overrides.push_back(scene::Override::parse(o));
-    for (const auto& o : configuration.newton) {
-      scene::Override newton = scene::Override::parse(o);
-      newton.path = "Newton/" + newton.path;
-      overrides.push_back(newton);
+  std::vector<scene::SceneConfig> scenes;
+  std::vector<const StudySettings::Configuration*> configurations;
+  const std::vector<double> cell_sizes = settings.cell_sizes.empty() ? std::vector<double>{0.0} : settings.cell_sizes;
+  for (double h : cell_sizes)
+    for (const auto& configuration : settings.configurations) {
+      scenes.push_back(scene_for(settings, configuration, h));
+      configurations.push_back(&configuration);
+      simulation::check_memory(scenes.back(), comm);
     }
-    const scene::SceneConfig scene = scene::read_scene(relative_to(study_file, settings.scene), overrides);
-    const auto solver = linalg::SolverConfiguration::read(configuration.solver);
-    simulation::Simulation sim(scene, solver, comm);
+  std::ofstream out;
+  open_csv(out, settings.output_directory, "steps.csv", study_file, comm);
+  out << std::setprecision(9)
+      << "configuration,solver,frames,steps,newton_iterations,cg_iterations,assemblies,preconditioner_setups,"
+         "graph_builds,retries,wall_seconds,seconds_per_frame,operator_seconds,preconditioner_seconds,cg_seconds,"
+         "line_search_seconds,ranks,cell_size\n";
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const auto& configuration = *configurations[k];
+    simulation::Simulation sim(scenes[k], linalg::SolverConfiguration::read(configuration.solver), comm);
     simulation::RunSummary summary;
     comm.barrier();
     const auto start = std::chrono::steady_clock::now();
     for (int frame = 1; frame <= settings.frames; ++frame) {
-      sim.advance_to(frame / scene.simulation.frame_rate, summary);
+      sim.advance_to(frame / scenes[k].simulation.frame_rate, summary);
       if (comm.is_root())
-        log << configuration.label << ": frame " << frame << "/" << settings.frames << ", " << summary.steps
+        log << configuration.label << " (Δx " << scenes[k].grid.cell_size << "): frame " << frame << "/" << settings.frames << ", " << summary.steps
             << " steps, " << summary.newton_iterations << " Newton, " << summary.linear_iterations << " CG, "
             << std::setprecision(4) << seconds_since(start) << " s" << std::setprecision(6) << std::endl;
     }
-    const double wall = comm.max(seconds_since(start));
-    // Phase times: the slowest rank's.
-    const double operator_seconds = comm.max(summary.operator_seconds);
-    const double setup_seconds = comm.max(summary.preconditioner_seconds);
-    const double cg_seconds = comm.max(summary.cg_seconds);
-    const double line_search_seconds = comm.max(summary.line_search_seconds);
-    if (comm.is_root()) {
-      out << '"' << configuration.label << "\",\"" << std::filesystem::path(configuration.solver).filename().string()
-          << "\"," << settings.frames << ',' << summary.steps << ',' << summary.newton_iterations << ','
-          << summary.linear_iterations << ',' << summary.assemblies << ',' << summary.preconditioner_setups << ','
-          << summary.graph_builds << ',' << summary.retries << ',' << wall << ',' << wall / settings.frames << ','
-          << operator_seconds << ',' << setup_seconds << ',' << cg_seconds << ',' << line_search_seconds << ','
-          << comm.size() << '\n';
-      out.flush();
-    }
-    ++rows;
+    write_steps_row(out, settings, configuration, scenes[k].grid.cell_size, summary, comm.max(seconds_since(start)),
+                    comm);
   }
-  return rows;
+  return static_cast<int>(scenes.size());
+}
+
+// The configurations of the steps mode: the "Configurations" sublist (a sublist each), else one
+// per solver file; every one's scene and solver file read now, before any run starts.
+void read_configurations(const Teuchos::ParameterList& list, const std::string& file, StudySettings& settings) {
+  if (list.isSublist("Configurations")) {
+    const auto& configurations = list.sublist("Configurations");
+    for (auto it = configurations.begin(); it != configurations.end(); ++it) {
+      const std::string& name = configurations.name(it);
+      const std::string path = "Configurations/" + name;
+      if (!configurations.isSublist(name)) throw parameter_error(file, path, "expected a sublist");
+      const auto c = ConfigurationSettings::table().parse(
+          params::read_parameters(configurations.sublist(name), ConfigurationSettings::table().specs(), file, path));
+      if (c.solver.empty()) throw parameter_error(file, path + "/Solver", "give a solver file");
+      settings.configurations.push_back({name, study_input(file, path + "/Solver", c.solver), c.newton});
+    }
+  } else {
+    for (const auto& path : settings.solvers)
+      settings.configurations.push_back({std::filesystem::path(path).stem().string(), path, {}});
+  }
+  if (settings.configurations.empty())
+    throw parameter_error(file, "Configurations", "give at least one configuration (or Solvers)");
+  for (const auto& o : settings.scene_overrides) {
+    try {
+      (void)scene::Override::parse(o);
+    } catch (const InputError&) {
+      throw parameter_error(file, "Scene overrides", "'" + o + "' is not Path/To/Parameter=value");
+    }
+  }
+  for (double h : settings.cell_sizes.empty() ? std::vector<double>{0.0} : settings.cell_sizes)
+    for (const auto& c : settings.configurations) (void)scene_for(settings, c, h);
+  for (const auto& c : settings.configurations) {
+    (void)linalg::SolverConfiguration::read(c.solver);
+  }
 }
 }  // namespace
 
 StudySettings read_study(const std::string& file, const std::vector<scene::Override>& overrides) {
-  auto list = scene::read_xml_file(file);
+  auto list = params::read_xml_file(file);
   const auto& specs = StudySettings::table().specs();
   for (const auto& o : overrides) {
-    const ParameterSpec* spec = nullptr;
-    for (const auto& s : specs)
-      if (s.name == o.path) spec = &s;
-    if (spec == nullptr) throw InputError(file + ": --set '" + o.path + "': unknown parameter");
-    scene::set_entry(*list, o.path, scene::parse_value(*spec, o.value));
+    const auto spec = std::find_if(specs.begin(), specs.end(), [&](const auto& s) { return s.name == o.path; });
+    if (spec == specs.end()) throw InputError(file + ": --set '" + o.path + "': unknown parameter");
+    try {
+      params::set_entry(*list, o.path, params::parse_value(*spec, o.value));
+    } catch (const InputError& e) {
+      throw InputError(file + ": --set '" + o.path + "': " + e.what());
+    }
   }
   StudySettings settings =
-      StudySettings::table().parse(scene::read_parameters(*list, specs, file, "", {"Configurations"}));
+      StudySettings::table().parse(params::read_parameters(*list, specs, file, "", {"Configurations"}));
   if (settings.scene.empty() && settings.matrix_market_files.empty())
-    throw InputError(file + ": parameter 'Scene': a study needs a scene or Matrix Market files");
-  if (settings.mode == "steps") {
-    if (settings.scene.empty()) throw InputError(file + ": parameter 'Scene': the steps mode needs a scene");
-    for (const auto& o : settings.scene_overrides) {
-      try {
-        (void)scene::Override::parse(o);
-      } catch (const InputError&) {
-        throw InputError(file + ": parameter 'Scene overrides': '" + o + "' is not Path/To/Parameter=value");
-      }
-    }
-    // Configurations: the "Configurations" sublist (a sublist each), else one per solver file.
-    if (list->isSublist("Configurations")) {
-      const auto& configurations = list->sublist("Configurations");
-      for (auto it = configurations.begin(); it != configurations.end(); ++it) {
-        const std::string& name = configurations.name(it);
-        const std::string path = "Configurations/" + name;
-        if (!configurations.isSublist(name)) throw InputError(file + ": parameter '" + path + "': expected a sublist");
-        const auto c = ConfigurationSettings::table().parse(scene::read_parameters(
-            configurations.sublist(name), ConfigurationSettings::table().specs(), file, path));
-        if (c.solver.empty()) throw InputError(file + ": parameter '" + path + "/Solver': give a solver file");
-        settings.configurations.push_back({name, relative_to(file, c.solver), c.newton});
-      }
-    } else {
-      for (const auto& s : settings.solvers) {
-        const std::string path = relative_to(file, s);
-        settings.configurations.push_back({std::filesystem::path(path).stem().string(), path, {}});
-      }
-    }
-    if (settings.configurations.empty())
-      throw InputError(file + ": parameter 'Configurations': give at least one configuration (or Solvers)");
-    // Every override is checked now, before any run starts.
-    for (const auto& c : settings.configurations) {
-      std::vector<scene::Override> overrides;
-      for (const auto& o : settings.scene_overrides) overrides.push_back(scene::Override::parse(o));
-      for (const auto& o : c.newton) {
-        scene::Override newton = scene::Override::parse(o);
-        newton.path = "Newton/" + newton.path;
-        overrides.push_back(newton);
-      }
-      (void)scene::read_scene(relative_to(file, settings.scene), overrides);
-      (void)linalg::SolverConfiguration::read(c.solver);
-    }
+    throw parameter_error(file, "Scene", "a study needs a scene or Matrix Market files");
+  // The files the study names, resolved against it: a missing one names the study's parameter.
+  if (!settings.scene.empty()) settings.scene = study_input(file, "Scene", settings.scene);
+  for (auto& s : settings.solvers) s = study_input(file, "Solvers", s);
+  for (auto& m : settings.matrix_market_files) m = study_input(file, "Matrix Market files", m);
+  if (settings.mode == StudyMode::steps) {
+    if (settings.scene.empty()) throw parameter_error(file, "Scene", "the steps mode needs a scene");
+    read_configurations(*list, file, settings);
     return settings;
   }
   if (!settings.scene.empty() && settings.cell_sizes.empty())
-    throw InputError(file + ": parameter 'Cell sizes': give at least one resolution");
-  if (settings.solvers.empty()) throw InputError(file + ": parameter 'Solvers': give at least one solver file");
+    throw parameter_error(file, "Cell sizes", "give at least one resolution");
+  if (settings.solvers.empty()) throw parameter_error(file, "Solvers", "give at least one solver file");
+  for (double h : settings.cell_sizes)
+    if (!settings.scene.empty()) (void)scene_at(settings, h);
+  for (const auto& s : settings.solvers) (void)linalg::SolverConfiguration::read(s);
   return settings;
 }
 
 int run_study(const StudySettings& settings, const std::string& study_file, const parallel::Communicator& comm,
               std::ostream& log) {
-  const std::string& directory = settings.output_directory;
-  if (comm.is_root()) std::filesystem::create_directories(directory);
-  comm.barrier();
-  if (settings.mode == "steps") return study_steps(settings, study_file, comm, log);
-  std::vector<linalg::SolverConfiguration> configs;
-  for (const auto& s : settings.solvers) configs.push_back(linalg::SolverConfiguration::read(relative_to(study_file, s)));
-  Writer writer(directory, comm.is_root(), comm.size());
-  if (!settings.scene.empty()) study_scene_systems(settings, study_file, configs, comm, writer, log);
-  study_matrix_market(settings, study_file, configs, comm, writer, log);
+  if (settings.mode == StudyMode::steps) {
+    create_output_directory(settings, study_file, comm);
+    return study_steps(settings, study_file, comm, log);
+  }
+  const SystemsInputs inputs = read_systems_inputs(settings, comm);
+  create_output_directory(settings, study_file, comm);
+  Writer writer(settings.output_directory, study_file, comm);  // truncates study.csv, operators.csv
+  study_scene_systems(settings, inputs, comm, writer, log);
+  study_matrix_market(inputs, settings, comm, writer, log);
   return writer.rows();
 }
 

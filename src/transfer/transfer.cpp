@@ -4,12 +4,6 @@
 
 namespace viscompm::transfer {
 
-Scheme scheme_from_name(const std::string& name) {
-  if (name == "apic") return Scheme::apic;
-  if (name == "pic_flip") return Scheme::pic_flip;
-  throw InputError("unknown transfer '" + name + "' (expected apic or pic_flip)");
-}
-
 void particles_to_grid(const particles::ParticleSet& particles, const grid::GridLayout& layout,
                        Scheme scheme, NodeScalarField& mass, NodeVectorField& momentum) {
   mass.assign(layout.local_node_count(), 0.0);

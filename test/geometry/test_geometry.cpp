@@ -1,16 +1,18 @@
 // Meshes and their level sets: OBJ, ASCII STL and binary STL read to the same surface; the
 // signed distance of a sphere mesh matches the analytic one within a cell; a body sampled from a
 // closed mesh has the mesh's volume; open meshes are told apart; scene errors name the scene
-// file, the parameter and the mesh file.
+// file, the parameter and the mesh file; a stop request ends OpenVDB's level-set builds.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include "viscompm/core/error.hpp"
+#include "viscompm/core/stop_request.hpp"
 #include "viscompm/geometry/level_set.hpp"
 #include "viscompm/geometry/mesh.hpp"
 #include "viscompm/particles/sampling.hpp"
@@ -223,4 +225,31 @@ TEST(ParticleSurface, EnclosesTheParticlesOfABallAndIsWrittenForRenderers) {
     EXPECT_NEAR(hi[d], particles_hi[d] + h, 0.25 * h);
     EXPECT_NEAR(lo[d], particles_lo[d] - h, 0.25 * h);
   }
+}
+
+// A stop request (here SIGUSR1, recorded by the handler) ends a mesh's level-set build and a
+// frame's surface with StopRequested naming the signal, and the surface's .vdb is not written;
+// once the request is forgotten, the same builds complete.
+TEST(StopRequest, EndsLevelSetBuildsWithStopRequested) {
+  const auto mesh = sphere_mesh(Vec3::Zero(), 0.3, 64);
+  const std::vector<Vec3> positions = {Vec3::Zero(), Vec3(0.01, 0.0, 0.0)};
+  const std::string vdb = temp_path("stopped_surface.vdb");
+  std::filesystem::remove(vdb);
+  install_stop_handlers();
+  clear_stop_signal();
+  std::raise(SIGUSR1);
+  ASSERT_EQ(stop_signal(), SIGUSR1);
+  try {
+    geometry::LevelSet level_set(mesh, 0.01, 3);
+    ADD_FAILURE() << "the level set was built despite the stop request";
+  } catch (const StopRequested& e) {
+    EXPECT_EQ(e.signal, SIGUSR1);
+  }
+  EXPECT_THROW(geometry::particle_surface(positions, 0.01, 0.005, vdb), StopRequested);
+  EXPECT_FALSE(std::filesystem::exists(vdb));
+  clear_stop_signal();
+  const geometry::LevelSet level_set(mesh, 0.01, 3);
+  EXPECT_LT(level_set.signed_distance(Vec3::Zero()), 0.0);
+  EXPECT_FALSE(geometry::particle_surface(positions, 0.01, 0.005, vdb).triangles.empty());
+  EXPECT_TRUE(std::filesystem::exists(vdb));
 }

@@ -101,6 +101,12 @@ for frame in range(3):
         if ids0 is None:
             ids0 = ids
         check(np.array_equal(ids, ids0), "ids are stable across frames")
+        # The colliders' surfaces: one collider index per triangle (issue 17, class 9).
+        m = f["colliders/triangles"].shape[0]
+        check(f["colliders/triangles"].shape == (m, 3) and f["colliders/collider_id"].shape == (m,),
+              f"colliders: triangles (m, 3) and collider_id (m), got {f['colliders/triangles'].shape}, "
+              f"{f['colliders/collider_id'].shape}")
+        check(set(np.unique(f["colliders/collider_id"][...])) == {0, 1, 2}, "every collider has triangles")
         F = p["deformation_gradient"][...]
         bE = p["left_cauchy_green_elastic"][...]
         J = np.linalg.det(F)

@@ -2,6 +2,7 @@
 // the variables y = (F̂, Ŝ, ε̂) and in the step variable A, at random feasible states.
 #include <gtest/gtest.h>
 
+#include "model_variants.hpp"
 #include "test_helpers.hpp"
 #include "viscompm/materials/oldroyd_b.hpp"
 
@@ -92,12 +93,11 @@ TEST(OldroydBEnergy, ElasticStrainHasDeterminantJSquared) {
 class OldroydBMaterial : public ::testing::TestWithParam<std::string> {
  protected:
   OldroydB material() const {
-    OldroydBParameters p;
+    OldroydBParameters p = testkit::parsed_parameters<OldroydBParameters>({{"Viscosity convention", GetParam()}});
     p.density = 2.0;
     p.shear_modulus = 360.0;
     p.lame_lambda = 1400.0;
     p.newtonian_viscosity = 0.3;
-    p.viscosity_convention = GetParam();
     p.weissenberg = 0.8;
     return OldroydB("test", p);
   }
@@ -165,8 +165,8 @@ INSTANTIATE_TEST_SUITE_P(Conventions, OldroydBMaterial, ::testing::Values("paper
 TEST(ViscosityConvention, PaperAndPhysicalCoefficients) {
   OldroydBParameters p;
   p.newtonian_viscosity = 2.5;
-  p.viscosity_convention = "paper";
+  p.viscosity_convention = ViscosityConvention::paper;
   EXPECT_DOUBLE_EQ(OldroydB("a", p).viscous_coefficient(0.01), 2.5);  // Φ^N = μ^N ε̂:ε̂ V^n (5.11)
-  p.viscosity_convention = "physical";
+  p.viscosity_convention = ViscosityConvention::physical;
   EXPECT_DOUBLE_EQ(OldroydB("b", p).viscous_coefficient(0.01), 0.025);  // Φ^N = Δt η ε̂:ε̂ V^n
 }

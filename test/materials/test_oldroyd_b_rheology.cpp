@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "model_variants.hpp"
 #include "viscompm/materials/oldroyd_b.hpp"
 
 using namespace viscompm;
@@ -15,9 +16,8 @@ namespace {
 constexpr double wi = 0.5, rate = 2.0, end_time = 1.0;
 
 OldroydB material(const std::string& update) {
-  OldroydBParameters p;
+  OldroydBParameters p = testkit::parsed_parameters<OldroydBParameters>({{"Strain update", update}});
   p.weissenberg = wi;
-  p.strain_update = update;
   return OldroydB("fluid", p);
 }
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "model_variants.hpp"
 #include "test_helpers.hpp"
 #include "viscompm/materials/herschel_bulkley.hpp"
 #include "viscompm/materials/oldroyd_b.hpp"
@@ -25,9 +26,8 @@ std::unique_ptr<Material> make(const std::string& update) {
     p.flow_index = 0.7;
     return std::make_unique<HerschelBulkley>("hb", p);
   }
-  OldroydBParameters p;
+  OldroydBParameters p = testkit::parsed_parameters<OldroydBParameters>({{"Strain update", update}});
   p.weissenberg = 0.02;  // Δt/Wi = 0.5
-  p.strain_update = update;
   return std::make_unique<OldroydB>("ob", p);
 }
 
@@ -111,9 +111,9 @@ TEST(StrainUpdates, FeRecastGivesTheOldroydBStrainAsFeFeTransposed) {
   for (double step : {1e-2, 5e-3, 2.5e-3, 1.25e-3}) {
     OldroydBParameters p;
     p.weissenberg = 0.5;
-    p.strain_update = "f_e";
+    p.strain_update = OldroydBUpdate::f_e;
     const OldroydB fe("fe", p);
-    p.strain_update = "paper";
+    p.strain_update = OldroydBUpdate::paper;
     const OldroydB paper("paper", p);
     particles::ParticleSet a, b;
     a.add(0, Vec3::Zero(), Vec3::Zero(), 1.0, 1.0, 0);

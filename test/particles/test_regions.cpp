@@ -24,14 +24,14 @@ TEST(Regions, AssignTheirMaterialToTheParticlesInside) {
   ball.name = "ball";
   ball.body = "crust";
   ball.material = "filling";
-  ball.shape = "sphere";
+  ball.shape = scene::ShapeKind::sphere;
   ball.center = Vec3(0.5, 0.35, 0.5);
   ball.radius = 0.12;
   scene::RegionSettings cuts;
   cuts.name = "cuts";
   cuts.body = "crust";
   cuts.material = "scored";
-  cuts.shape = "cuts";
+  cuts.shape = scene::ShapeKind::cuts;
   cuts.center = Vec3(0.5, 0.35, 0.5);
   cuts.axis = Vec3::UnitY();
   cuts.cut_count = 3;

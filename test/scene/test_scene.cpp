@@ -151,7 +151,9 @@ TEST(Scene, EverySceneFileParsesAndEveryModelHasAScene) {
     ++scenes;
     scene::SceneConfig s;
     EXPECT_NO_THROW(s = scene::read_scene(entry.path().string())) << entry.path();
-    EXPECT_TRUE(std::filesystem::exists(s.solver_file)) << entry.path();
+    // Its own solver file, or the built-in default (no Solver section).
+    EXPECT_TRUE(s.solver_file.empty() || std::filesystem::exists(s.solver_file)) << entry.path();
+    EXPECT_NO_THROW(scene::solver_configuration(s)) << entry.path();
     for (const auto& m : s.materials) models_in_scenes.insert(m.model);
     // Each scene can be built: its materials from the registry.
     for (const auto& m : s.materials) EXPECT_NO_THROW(materials::find_model(m.model)->create(m.name, m.values));
@@ -159,6 +161,27 @@ TEST(Scene, EverySceneFileParsesAndEveryModelHasAScene) {
   EXPECT_GE(scenes, 14);  // the model scenes and the paper's (inputs/scenes/paper/)
   for (const auto& model : materials::model_names())
     EXPECT_TRUE(models_in_scenes.count(model)) << "no scene in inputs/scenes uses " << model;
+}
+
+TEST(Scene, WithoutASolverSectionTheBuiltInDefaultSolverIsUsedWhereverTheSceneLives) {
+  // The default scene without its Solver section, in a folder with no solvers/ beside it.
+  std::string text = read_text(default_scene);
+  const auto begin = text.find("<ParameterList name=\"Solver\">");
+  const auto end = text.find("</ParameterList>", begin) + std::string("</ParameterList>").size();
+  text.erase(begin, end - begin);
+  const auto folder = std::filesystem::temp_directory_path() / ("viscompm_no_solver_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder / "deeper");
+  const std::string file = (folder / "deeper" / "scene.xml").string();
+  std::ofstream(file) << text;
+  const auto s = scene::read_scene(file);
+  EXPECT_TRUE(s.solver_file.empty());
+  const auto built_in = scene::solver_configuration(s);
+  const auto shipped = linalg::SolverConfiguration::read(inputs + "/solvers/jacobi_cg.xml");
+  EXPECT_EQ(built_in.label(), shipped.label());
+  EXPECT_NE(built_in.origin().find("built-in"), std::string::npos) << built_in.origin();
+  // A Solver/File given is still resolved against the scene and must exist.
+  expect_one_line_naming(read_error(file, {{"Solver/File", "../solvers/jacobi_cg.xml"}}), file, "Solver/File");
+  std::filesystem::remove_all(folder);
 }
 
 TEST(Scene, MissingFileAndMalformedXmlAreInputErrors) {
@@ -202,6 +225,35 @@ TEST(CommandLine, AcceptsTheContractForms) {
   EXPECT_THROW(scene::parse_command_line(3, bad, scene::ProgramOptions{"viscompm", "test"}), InputError);
   const char* none[] = {"viscompm"};
   EXPECT_THROW(scene::parse_command_line(1, none, scene::ProgramOptions{"viscompm", "test"}), InputError);
+}
+
+// Issue 17, class 6: an option given twice, or a parameter set twice, would silently keep the
+// last; a --frames that is not a number is reported as --frames.
+TEST(CommandLine, RepeatedOptionsAndParametersSetTwiceAreRejected) {
+  auto error = [](std::vector<const char*> argv) {
+    try {
+      scene::parse_command_line(static_cast<int>(argv.size()), argv.data(), scene::ProgramOptions{"viscompm", "test"});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string m = error({"viscompm", "scene.xml", "--solver", "a.xml", "--solver=b.xml"});
+  EXPECT_NE(m.find("--solver is given more than once"), std::string::npos) << m;
+  for (const char* option : {"--output", "--frames", "--restart"}) {
+    m = error({"viscompm", "scene.xml", option, "1", option, "2"});
+    EXPECT_NE(m.find(std::string(option) + " is given more than once"), std::string::npos) << m;
+  }
+  m = error({"viscompm", "scene.xml", "--set", "Grid/Cell size=0.1", "--set", "Grid/Cell size=0.2"});
+  EXPECT_NE(m.find("'Grid/Cell size' is set twice (--set and --set)"), std::string::npos) << m;
+  m = error({"viscompm", "scene.xml", "--frames", "2", "--set", "Simulation/Frames=3"});
+  EXPECT_NE(m.find("'Simulation/Frames' is set twice (--set and --frames)"), std::string::npos) << m;
+  for (const char* frames : {"abc", "-1", "2x", "", "99999999999"}) {
+    m = error({"viscompm", "scene.xml", "--frames", frames});
+    EXPECT_NE(m.find("option --frames: '" + std::string(frames) + "' is not a number of frames"), std::string::npos) << m;
+    EXPECT_EQ(m.find("Simulation/Frames"), std::string::npos) << m;
+  }
+  EXPECT_EQ(error({"viscompm", "scene.xml", "--set", "A/B=1", "--set", "C/D=2", "--frames", "0"}), "");
 }
 
 TEST(Scene, AMissingSolverFileNamesTheSceneAndTheParameter) {
@@ -308,7 +360,8 @@ TEST(Scene, MotionsEmittersAndRegionsAreValidatedOnRead) {
                  "<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{0, -1, 0}\"/>");
   const auto s = scene::read_scene(file);
   ASSERT_EQ(s.emitters.size(), 1u);
-  EXPECT_EQ(s.emitters[0].shape, "cylinder");  // a disc: a cylinder along the velocity, two cells long
+  EXPECT_EQ(s.emitters[0].shape, scene::ShapeKind::disc);  // a cylinder along the velocity, two cells long
+  EXPECT_EQ(scene::shape_of(s.emitters[0]).kind, Shape::Kind::cylinder);
   EXPECT_EQ(s.emitters[0].axis, Vec3(0, -1, 0));
   EXPECT_DOUBLE_EQ(s.emitters[0].length, 2 * s.grid.cell_size);
   // Regions: a known body and material.
@@ -324,7 +377,8 @@ TEST(Scene, MotionsEmittersAndRegionsAreValidatedOnRead) {
                 "<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>");
   expect_one_line_naming(read_error(file), file, "Regions/core/Shape");
   // --set reaches the new sections.
-  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>");
+  file = emitter("<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>"
+                 "<Parameter name=\"Center\" type=\"Array(double)\" value=\"{0.6, 1.0, 0.36}\"/>");
   EXPECT_EQ(scene::read_scene(file, {{"Emitters/tap/Mass rate", "0.25"}}).emitters[0].mass_rate, 0.25);
 }
 
@@ -416,4 +470,114 @@ TEST(SolverConfiguration, ValidatesMueLuAndIfpack2NamesTypesAndValues) {
   // Parameters for a preconditioner that takes none.
   expect_one_line_naming(solver_error("none", parameter("relaxation: type", "string", "Jacobi")), "solver.xml",
                          "Preconditioner parameters");
+}
+
+// Issue 17, classes 1-4: what reading a scene must answer (exit 2, one line naming the file and
+// the parameter) instead of running with a changed value or failing later.
+TEST(Scene, NonFiniteOrOverflowingItemsOfListsAreRejectedNotReplaced) {
+  const std::string bullet_velocity = "<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{4, 0, 0}\"/>";
+  for (const auto& [entries, parameter] : std::vector<std::pair<std::string, std::string>>{
+           {"<Parameter name=\"Angular velocity\" type=\"Array(double)\" value=\"{0, nan, 0}\"/>",
+            "Colliders/bullet/Angular velocity"},
+           {"<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{1e400, 0, 0}\"/>", "Colliders/bullet/Velocity"},
+           {"<Parameter name=\"Keyframe times\" type=\"Array(double)\" value=\"{0, 0.1}\"/>"
+            "<Parameter name=\"Keyframe positions\" type=\"Array(double)\" value=\"{0, 0, 0, inf, 0, 0}\"/>",
+            "Colliders/bullet/Keyframe positions"},
+           {"<Parameter name=\"Keyframe times\" type=\"Array(double)\" value=\"{0, -inf}\"/>",
+            "Colliders/bullet/Keyframe times"}}) {
+    const std::string file = variant(bullet_velocity, entries);
+    const std::string message = read_error(file);
+    expect_one_line_naming(message, file, parameter);
+    EXPECT_NE(message.find("is not a finite number"), std::string::npos) << message;
+  }
+}
+
+namespace {
+// An ASCII STL of one closed tetrahedron, its first corner replaced by `corner`.
+std::string tetrahedron_stl(const std::string& corner) {
+  const std::string v[4] = {corner, "1 0 0", "0 1 0", "0 0 1"};
+  const int faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  std::string text = "solid t\n";
+  for (const auto& f : faces) {
+    text += "facet normal 0 0 0\nouter loop\n";
+    for (int k : f) text += "vertex " + v[k] + "\n";
+    text += "endloop\nendfacet\n";
+  }
+  const std::string file = std::filesystem::temp_directory_path() / ("viscompm_mesh_" + std::to_string(::getpid()) + ".stl");
+  std::ofstream(file) << text + "endsolid t\n";
+  return file;
+}
+
+// The default scene with a mesh collider (or body) of `mesh` and `extra` entries.
+std::string with_mesh(const std::string& section, const std::string& mesh, const std::string& extra = "") {
+  const std::string entries = "<ParameterList name=\"mesh\"><Parameter name=\"Shape\" type=\"string\" value=\"mesh\"/>"
+                              "<Parameter name=\"File\" type=\"string\" value=\"" + mesh + "\"/>"
+                              "<Parameter name=\"Scale\" type=\"double\" value=\"0.1\"/>"
+                              "<Parameter name=\"Center\" type=\"Array(double)\" value=\"{0.5, 0.5, 0.3}\"/>" +
+                              extra + (section == "Bodies" ? "<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>" : "") +
+                              "</ParameterList>";
+  const std::string open = "<ParameterList name=\"" + section + "\">";
+  return variant(open, open + entries);
+}
+}  // namespace
+
+TEST(Scene, MeshVerticesMustBeFinite) {
+  for (const std::string section : {"Colliders", "Bodies"}) {
+    EXPECT_NO_THROW(scene::read_scene(with_mesh(section, tetrahedron_stl("0 0 0")))) << section;
+    // One coordinate, or all three (Assimp's merging of identical vertices swallowed such a corner;
+    // found by fuzzing).
+    for (const char* corner : {"nan 0 0", "nan nan nan", "0 inf 0"}) {
+      const std::string file = with_mesh(section, tetrahedron_stl(corner));
+      const std::string message = read_error(file);
+      expect_one_line_naming(message, file, section + "/mesh/File");
+      EXPECT_NE(message.find("is not finite"), std::string::npos) << message;  // not "not closed"
+    }
+  }
+  // Finite in the file, but not once scaled.
+  const std::string file = with_mesh("Colliders", tetrahedron_stl("1e300 0 0"), "");
+  expect_one_line_naming(read_error(file, {{"Colliders/mesh/Scale", "1e300"}}), file, "Colliders/mesh/File");
+}
+
+TEST(Scene, VoxelsMustBeWhatOpenVdbAndTheMemoryCanTake) {
+  const std::string mesh = tetrahedron_stl("0 0 0");
+  // Below OpenVDB's smallest voxel; a band of about 10^12 voxels (a 10 m tetrahedron at 20 µm).
+  for (const auto& [voxel, scale, reason] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"1e-6", "0.1", "smallest OpenVDB takes"}, {"2e-5", "10", "GiB"}}) {
+    const std::string file = with_mesh("Colliders", mesh, "<Parameter name=\"Voxel size\" type=\"double\" value=\"" + voxel + "\"/>");
+    const std::string message = read_error(file, {{"Colliders/mesh/Scale", scale}});
+    expect_one_line_naming(message, file, "Colliders/mesh/Voxel size");
+    EXPECT_NE(message.find(reason), std::string::npos) << message;
+  }
+  const std::string message = read_error(default_scene, {{"Output/Surface voxel size", "1e-7"}});
+  expect_one_line_naming(message, default_scene, "Output/Surface voxel size");
+}
+
+TEST(Scene, MotionsAtTheirLimitsAreCheckedOnRead) {
+  // A collider that stops before it starts (emitters were already checked).
+  std::string message = read_error(default_scene, {{"Colliders/bullet/Start time", "2"}, {"Colliders/bullet/Stop time", "1"}});
+  expect_one_line_naming(message, default_scene, "Colliders/bullet/Stop time");
+  // Speeds whose CFL step is below Min time step: a run could not take a single step.
+  for (const auto& [parameter, value] : std::vector<std::pair<std::string, std::string>>{
+           {"Colliders/bullet/Angular velocity", "{0, 0, 1e8}"},
+           {"Colliders/bullet/Velocity", "{1e7, 0, 0}"},
+           {"Colliders/bullet/Surface velocity", "{0, 1e7, 0}"},
+           {"Bodies/sponge/Velocity", "{0, 1e7, 0}"},
+           {"Bodies/sponge/Angular velocity", "{1e8, 0, 0}"}}) {
+    message = read_error(default_scene, {{parameter, value}});
+    expect_one_line_naming(message, default_scene, parameter);
+    EXPECT_NE(message.find("Min time step"), std::string::npos) << message;
+  }
+  EXPECT_NO_THROW(scene::read_scene(default_scene, {{"Colliders/bullet/Angular velocity", "{0, 0, 1e3}"}}));
+}
+
+TEST(Scene, NozzlesMustLieInsideTheGrid) {
+  const std::string output = "<ParameterList name=\"Output\">";
+  const std::string file = variant(output, "<ParameterList name=\"Emitters\"><ParameterList name=\"tap\">"
+                                           "<Parameter name=\"Material\" type=\"string\" value=\"sponge\"/>"
+                                           "<Parameter name=\"Velocity\" type=\"Array(double)\" value=\"{0, -1, 0}\"/>"
+                                           "<Parameter name=\"Center\" type=\"Array(double)\" value=\"{0.6, 1.0, 0.36}\"/>"
+                                           "</ParameterList></ParameterList>" + output);
+  EXPECT_NO_THROW(scene::read_scene(file));
+  for (const char* centre : {"{0.6, 1.19, 0.36}", "{0.6, 5, 0.36}", "{0.05, 1.0, 0.36}"})
+    expect_one_line_naming(read_error(file, {{"Emitters/tap/Center", centre}}), file, "Emitters/tap/Center");
 }

@@ -21,7 +21,7 @@ TEST(MovingColliders, ABlockGluedToARotatingGripTurnsRigidly) {
   // A stiff, elastic block whose lower part sits in the grip.
   scene.materials.push_back(testkit::oldroyd_b_material("stiff", 1.0, 4000.0, 16000.0, 0.0, "paper", 1e30));
   scene.bodies.push_back(testkit::box_body("stiff", Vec3(0.4, 0.2, 0.4), Vec3(0.6, 0.55, 0.6), Vec3::Zero()));
-  auto grip = testkit::box_collider("grip", "sticky", Vec3(0.35, 0.1, 0.35), Vec3(0.65, 0.3, 0.65));
+  auto grip = testkit::box_collider("grip", boundary::ContactType::sticky, Vec3(0.35, 0.1, 0.35), Vec3(0.65, 0.3, 0.65));
   grip.angular_velocity = Vec3(0.0, 2.0, 0.0);
   grip.rotation_center = Vec3(0.5, 0.0, 0.5);
   scene.colliders.push_back(grip);
@@ -56,7 +56,7 @@ TEST(MovingColliders, ABeltCarriesABlockRestingOnItAtTheBeltSpeed) {
   scene.newton.tolerance = 1e-8;
   scene.materials.push_back(testkit::oldroyd_b_material("block", 1.0, 500.0, 2000.0, 0.0, "paper", 1e30));
   scene.bodies.push_back(testkit::box_body("block", Vec3(0.2, 0.2, 0.15), Vec3(0.4, 0.32, 0.35), Vec3::Zero()));
-  auto belt = testkit::box_collider("belt", "sticky", Vec3(-0.1, -0.1, -0.1), Vec3(1.3, 0.2, 0.6));
+  auto belt = testkit::box_collider("belt", boundary::ContactType::sticky, Vec3(-0.1, -0.1, -0.1), Vec3(1.3, 0.2, 0.6));
   belt.surface_velocity = Vec3(0.5, 0.0, 0.0);
   scene.colliders.push_back(belt);
   const parallel::Communicator comm(MPI_COMM_WORLD);
@@ -84,7 +84,7 @@ TEST(MovingColliders, ParticlesThrownAtAThinSlipPlateDoNotCrossIt) {
   scene.materials.push_back(testkit::oldroyd_b_material("goo", 1.0, 20.0, 100.0, 0.0, "paper", 0.1));
   scene.bodies.push_back(testkit::box_body("goo", Vec3(0.2, 0.2, 0.25), Vec3(0.4, 0.4, 0.4), Vec3(0.0, 0.0, 4.0)));
   // 1 cm thick, between the node planes z = 0.5 and 0.55: no node lies inside it.
-  scene.colliders.push_back(testkit::box_collider("plate", "slip", Vec3(-0.1, -0.1, 0.51), Vec3(0.7, 0.7, 0.52)));
+  scene.colliders.push_back(testkit::box_collider("plate", boundary::ContactType::slip, Vec3(-0.1, -0.1, 0.51), Vec3(0.7, 0.7, 0.52)));
   const parallel::Communicator comm(MPI_COMM_WORLD);
   simulation::Simulation sim(scene, testkit::jacobi_cg(1e-8), comm);
   simulation::RunSummary summary;

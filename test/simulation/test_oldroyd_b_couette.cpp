@@ -43,15 +43,15 @@ Measurement run_couette(const std::string& update) {
   // The fluid fills the gap from one slip wall of the domain to the other in x, so that no free end
   // lets the flow's normal stresses pull it away from simple shear; near the walls the flow turns,
   // in the middle it is a Couette flow. Slip planes at its z faces make the flow plane.
-  scene.grid.walls = "slip";
-  scene.colliders.push_back(testkit::box_collider("front plane", "slip", Vec3(-10, -10, -1), Vec3(10, 10, 0.15)));
-  scene.colliders.push_back(testkit::box_collider("back plane", "slip", Vec3(-10, -10, 0.25), Vec3(10, 10, 1)));
+  scene.grid.walls = boundary::ContactType::slip;
+  scene.colliders.push_back(testkit::box_collider("front plane", boundary::ContactType::slip, Vec3(-10, -10, -1), Vec3(10, 10, 0.15)));
+  scene.colliders.push_back(testkit::box_collider("back plane", boundary::ContactType::slip, Vec3(-10, -10, 0.25), Vec3(10, 10, 1)));
   scene.bodies.push_back(testkit::box_body("fluid", Vec3(0.05, y_bottom, 0.15),
                                            Vec3(length - 0.05, y_bottom + gap, 0.25), Vec3::Zero()));
   // Plates far longer than the domain, so the covered nodes never change as they slide.
-  scene.colliders.push_back(testkit::box_collider("bottom plate", "sticky", Vec3(-10, 0.05, -1),
+  scene.colliders.push_back(testkit::box_collider("bottom plate", boundary::ContactType::sticky, Vec3(-10, 0.05, -1),
                                                   Vec3(10, y_bottom, 1), Vec3(-plate_speed, 0, 0)));
-  scene.colliders.push_back(testkit::box_collider("top plate", "sticky", Vec3(-10, y_bottom + gap, -1),
+  scene.colliders.push_back(testkit::box_collider("top plate", boundary::ContactType::sticky, Vec3(-10, y_bottom + gap, -1),
                                                   Vec3(10, y_bottom + gap + 0.25, 1), Vec3(plate_speed, 0, 0)));
   scene.simulation.max_time_step = wi / 10.0;
   scene.newton.tolerance = 1e-8;

@@ -16,7 +16,7 @@
 #include "viscompm/io/frame_writer.hpp"
 #include "viscompm/io/particle_file.hpp"
 #include "viscompm/simulation/simulation.hpp"
-#include "viscompm/simulation/stop_request.hpp"
+#include "viscompm/core/stop_request.hpp"
 
 using namespace viscompm;
 
@@ -93,12 +93,12 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
 
   // SIGTERM reaches the last rank only, before the first step: every rank abandons that step at
   // its first Newton iteration and checkpoints the state before it.
-  simulation::install_stop_handlers();
-  simulation::clear_stop_signal();
+  install_stop_handlers();
+  clear_stop_signal();
   if (world.rank() == world.size() - 1) std::raise(SIGTERM);
   simulation::Simulation stopped(every_step(short_run(dir + "/stopped")), solver, world);
   const auto summary = stopped.run(log);
-  simulation::clear_stop_signal();
+  clear_stop_signal();
   EXPECT_EQ(summary.stop_signal, SIGTERM);
   EXPECT_EQ(stopped.step_count(), 0) << "every rank abandons the step during which the signal came";
   EXPECT_EQ(summary.stop_checkpoint, dir + "/stopped/" + io::step_checkpoint_file_name(0));

@@ -11,6 +11,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
 from script_checks import check, finish, program_arguments  # noqa: E402
@@ -104,6 +105,56 @@ if logged and rows:
 else:
     check(False, "MatrixMarket round trip produced rows")
 
+# Bad input (issue 17, class 5): exit 2 within seconds, one line naming the file and the parameter,
+# and the results of the run before (study.csv, operators.csv of out_mm) left as they were.
+def stderr_lines(result):
+    return [line for line in result.stderr.splitlines() if line.startswith("viscompm-study")]
+
+
+def previous_results(directory):
+    names = ("study.csv", "operators.csv")
+    return {n: open(os.path.join(directory, n)).read() for n in names if os.path.exists(os.path.join(directory, n))}
+
+
+before = previous_results(out + "_mm")
+check(len(before) == 2, "the MatrixMarket study left study.csv and operators.csv")
+cut = os.path.join(args.workdir, "cut")
+os.makedirs(cut, exist_ok=True)
+with open(os.path.join(run_dir, "newton_step_2.mtx")) as f:
+    matrix = f.read().splitlines()
+with open(os.path.join(run_dir, "newton_step_2_rhs.mtx")) as f:
+    rhs = f.read().splitlines()
+with open(os.path.join(cut, "short.mtx"), "w") as f:  # the size line promises more entries
+    f.write("\n".join(matrix[:len(matrix) // 2]) + "\n")
+with open(os.path.join(cut, "bad_rhs.mtx"), "w") as f:  # a right-hand side with a word in it
+    f.write("\n".join(matrix) + "\n")
+with open(os.path.join(cut, "bad_rhs_rhs.mtx"), "w") as f:
+    f.write("\n".join(rhs[:10] + ["abc"] + rhs[11:]) + "\n")
+with open(os.path.join(cut, "short_rhs_rhs.mtx"), "w") as f:  # a right-hand side cut short
+    f.write("\n".join(rhs[:len(rhs) // 2]) + "\n")
+os.link(os.path.join(cut, "bad_rhs.mtx"), os.path.join(cut, "short_rhs.mtx"))
+with open(mm_study) as f:
+    mm_text = f.read()
+cases = [("a missing scene", [f"Scene={args.workdir}/no_such_scene.xml", "Cell sizes={0.06}"], mm_study, "'Scene'"),
+         ("a missing solver file", [f"Solvers={{{solvers}/no_such_solver.xml}}"], mm_study, "'Solvers'"),
+         ("a missing MatrixMarket file", [f"Matrix Market files={{{cut}/none.mtx}}"], mm_study,
+          "'Matrix Market files'"),
+         ("a matrix cut short", [f"Matrix Market files={{{cut}/short.mtx}}"], os.path.join(cut, "short.mtx"),
+          "announces"),
+         ("a malformed right-hand side", [f"Matrix Market files={{{cut}/bad_rhs.mtx}}"],
+          os.path.join(cut, "bad_rhs_rhs.mtx"), "right-hand side"),
+         ("a right-hand side cut short", [f"Matrix Market files={{{cut}/short_rhs.mtx}}"],
+          os.path.join(cut, "short_rhs_rhs.mtx"), "right-hand side")]
+for what, sets, named_file, named_parameter in cases:
+    started = time.time()
+    result = run(args.study, mm_study, "--output", out + "_mm", *[a for s_ in sets for a in ("--set", s_)])
+    lines = stderr_lines(result)
+    check(result.returncode == 2, f"{what}: exit 2, got {result.returncode}: {result.stderr[-800:]}")
+    check(len(lines) == 1 and named_file in lines[0] and named_parameter in lines[0],
+          f"{what}: one line naming {named_file} and {named_parameter}: {lines}")
+    check(time.time() - started < 10, f"{what}: answered within seconds ({time.time() - started:.1f} s)")
+    check(previous_results(out + "_mm") == before, f"{what}: the earlier study.csv and operators.csv are intact")
+
 # The steps mode: two frames of the coarse sponge per configuration, exact and lagged Newton.
 steps_study = os.path.join(args.workdir, "steps.xml")
 with open(steps_study, "w") as f:
@@ -142,6 +193,17 @@ if len(rows) == 3:
         check(0.0 < phases <= float(r["wall_seconds"]) * 1.001, f"phases within the wall time: {r}")
         check(abs(float(r["seconds_per_frame"]) * 2 - float(r["wall_seconds"])) < 1e-7 * float(r["wall_seconds"]),
               "seconds per frame")
+    check(all(float(r["cell_size"]) == 0.06 for r in rows), "cell_size: the scene override's")
+# The steps mode at two cell sizes: one row per configuration and size, the size as asked (a
+# Cell sizes entry overrides the scene overrides' Grid/Cell size).
+result = run(args.study, steps_study, "--output", out + "_sizes", "--set", "Cell sizes={0.075, 0.1}",
+             "--set", "Frames=1")
+check(result.returncode == 0, f"steps study at two sizes exits 0: {result.stderr[-1500:]}")
+rows = list(csv.DictReader(open(os.path.join(out + "_sizes", "steps.csv")))) if result.returncode == 0 else []
+check([(r["configuration"], float(r["cell_size"])) for r in rows] ==
+      [(c, h) for h in (0.075, 0.1) for c in ("exact Newton", "once per step", "paper")], f"steps.csv rows {rows}")
+if len(rows) == 6:
+    check(int(rows[0]["cg_iterations"]) != int(rows[3]["cg_iterations"]), "the sizes are different problems")
 # A steps study whose configuration names a Newton parameter that does not exist is bad input.
 with open(steps_study) as f:
     bad = f.read().replace("Hessian update=every step", "Hessian updates=every step")

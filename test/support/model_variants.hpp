@@ -49,6 +49,15 @@ inline std::vector<ModelVariant> model_variants(double stress_scale = 1.0) {
   return out;
 }
 
+/// A model's parameters with their declared defaults, except `values` (words such as
+/// {"Strain update", "spd"} are parsed by the model's table, as a scene's are).
+template <class Parameters>
+Parameters parsed_parameters(const std::vector<std::pair<std::string, ParameterValue>>& values) {
+  ParameterValues given;
+  for (const auto& [name, value] : values) given.set(name, value);
+  return Parameters::table().parse(given);
+}
+
 /// The material of a variant; throws std::invalid_argument if it names an undeclared parameter.
 inline std::unique_ptr<materials::Material> build_material(const ModelVariant& v, const std::string& name) {
   const materials::ModelEntry* entry = materials::find_model(v.model);

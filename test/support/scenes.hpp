@@ -20,7 +20,7 @@ inline scene::SceneConfig base_scene(const Vec3& upper, double dx) {
   s.grid.lower_corner = Vec3::Zero();
   s.grid.upper_corner = upper;
   s.grid.cell_size = dx;
-  s.grid.walls = "separating";
+  s.grid.walls = boundary::ContactType::separating;
   s.simulation.gravity = Vec3::Zero();
   s.simulation.cfl = 10.0;
   s.newton.tolerance = 1e-9;
@@ -33,26 +33,21 @@ inline scene::MaterialSettings oldroyd_b_material(const std::string& name, doubl
   scene::MaterialSettings m;
   m.name = name;
   m.model = "oldroyd_b";
-  materials::OldroydBParameters p;
-  p.density = density;
-  p.shear_modulus = mu;
-  p.lame_lambda = lambda;
-  p.newtonian_viscosity = viscosity;
-  p.viscosity_convention = convention;
-  p.weissenberg = wi;
-  m.values.set("Density", p.density);
-  m.values.set("Shear modulus", p.shear_modulus);
-  m.values.set("Lame lambda", p.lame_lambda);
-  m.values.set("Newtonian viscosity", p.newtonian_viscosity);
-  m.values.set("Viscosity convention", p.viscosity_convention);
-  m.values.set("Weissenberg number", p.weissenberg);
+  // Every declared parameter: the defaults (the strain update), then these.
+  for (const auto& spec : materials::find_model("oldroyd_b")->parameters) m.values.set(spec.name, spec.default_value);
+  m.values.set("Density", density);
+  m.values.set("Shear modulus", mu);
+  m.values.set("Lame lambda", lambda);
+  m.values.set("Newtonian viscosity", viscosity);
+  m.values.set("Viscosity convention", convention);
+  m.values.set("Weissenberg number", wi);
   return m;
 }
 
 inline scene::BodySettings box_body(const std::string& material, const Vec3& lo, const Vec3& hi, const Vec3& v) {
   scene::BodySettings b;
   b.name = "body";
-  b.shape = "box";
+  b.shape = scene::ShapeKind::box;
   b.lower_corner = lo;
   b.upper_corner = hi;
   b.material = material;
@@ -60,11 +55,11 @@ inline scene::BodySettings box_body(const std::string& material, const Vec3& lo,
   return b;
 }
 
-inline scene::ColliderSettings box_collider(const std::string& name, const std::string& contact, const Vec3& lo,
+inline scene::ColliderSettings box_collider(const std::string& name, boundary::ContactType contact, const Vec3& lo,
                                             const Vec3& hi, const Vec3& v = Vec3::Zero()) {
   scene::ColliderSettings c;
   c.name = name;
-  c.shape = "box";
+  c.shape = scene::ShapeKind::box;
   c.contact = contact;
   c.lower_corner = lo;
   c.upper_corner = hi;
@@ -101,13 +96,13 @@ inline scene::SceneConfig sponge_scene() {
   auto goo = box_body("goo", Vec3(0.7, 0.3, 0.2), Vec3(0.85, 0.5, 0.4), Vec3(-0.5, 0.2, 0));
   goo.angular_velocity = Vec3(0, 0, 3);
   scene.bodies.push_back(goo);
-  scene.colliders.push_back(box_collider("bottom", "sticky", Vec3(0.3, 0.1, 0.15), Vec3(0.7, 0.25, 0.45)));
+  scene.colliders.push_back(box_collider("bottom", boundary::ContactType::sticky, Vec3(0.3, 0.1, 0.15), Vec3(0.7, 0.25, 0.45)));
   scene::ColliderSettings bullet;
   bullet.name = "bullet";
-  bullet.shape = "sphere";
+  bullet.shape = scene::ShapeKind::sphere;
   bullet.center = Vec3(0.25, 0.55, 0.3);
   bullet.radius = 0.08;
-  bullet.contact = "slip";
+  bullet.contact = boundary::ContactType::slip;
   bullet.velocity = Vec3(3, 0, 0);
   scene.colliders.push_back(bullet);
   return scene;
@@ -160,7 +155,7 @@ inline scene::SceneConfig mixed_models_scene() {
   auto cream = box_body("cream", Vec3(0.12, y0 + size, 0.15), Vec3(0.26, y0 + size + 0.1, 0.3), Vec3(1.5, -2.0, 0.0));
   cream.name = "cream";
   scene.bodies.push_back(cream);
-  scene.colliders.push_back(box_collider("table", "sticky", Vec3(0.0, 0.0, 0.0), Vec3(1.2, 0.2, 0.5)));
+  scene.colliders.push_back(box_collider("table", boundary::ContactType::sticky, Vec3(0.0, 0.0, 0.0), Vec3(1.2, 0.2, 0.5)));
   return scene;
 }
 

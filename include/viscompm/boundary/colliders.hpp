@@ -22,7 +22,6 @@
 namespace viscompm::boundary {
 
 enum class ContactType { sticky, slip, separating };
-ContactType contact_type_from_name(const std::string& name);
 
 struct Collider {
   std::string name;

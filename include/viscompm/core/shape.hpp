@@ -32,7 +32,6 @@ struct Shape {
   int cut_count = 4;               ///< cuts: planes through `center` containing `axis`, k·180°/count apart
   double cut_width = 0.01;         ///< cuts: thickness of each planar cut [m]
 
-  static Kind kind_from_name(const std::string& name);
   static std::string kind_name(Kind kind);
 
   /// The shape moved by `offset`.

@@ -14,7 +14,8 @@ namespace viscompm::geometry {
 class LevelSet : public DistanceField {
  public:
   /// The signed distance of a closed mesh sampled on voxels of size `voxel_size`, exact within
-  /// `band_voxels` voxels of the surface; beyond, ±band (inside/outside by flood fill).
+  /// `band_voxels` voxels of the surface; beyond, ±band (inside/outside by flood fill). A stop
+  /// request (core/stop_request.hpp) ends the computation with StopRequested.
   LevelSet(const TriangleMesh& mesh, double voxel_size, int band_voxels = 3);
   ~LevelSet() override;
 
@@ -35,7 +36,8 @@ class LevelSet : public DistanceField {
 
 /// The surface of a particle cloud: spheres of `radius` rasterised into a level set of voxel
 /// `voxel_size` (OpenVDB ParticlesToLevelSet), meshed at its zero crossing (volumeToMesh).
-/// With a non-empty `vdb_file`, the level set is also written there (for renderers).
+/// With a non-empty `vdb_file`, the level set is also written there (for renderers). A stop
+/// request ends the rasterisation with StopRequested (nothing written).
 TriangleMesh particle_surface(const std::vector<Vec3>& positions, double radius, double voxel_size,
                               const std::string& vdb_file = "");
 

@@ -21,7 +21,8 @@ struct TriangleMesh {
 };
 
 /// Reads every mesh of an OBJ or STL file (identical vertices merged) into one triangle mesh.
-/// Throws InputError("<file>: <reason>") when the file is missing, unreadable or empty.
+/// Throws InputError("<file>: <reason>") when the file is missing, unreadable, empty or has a
+/// non-finite vertex.
 TriangleMesh read_mesh(const std::string& file);
 
 /// x ↦ scale·x + offset applied to every vertex.

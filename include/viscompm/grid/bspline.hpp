@@ -22,7 +22,6 @@ constexpr double apic_inertia_factor(KernelOrder order) {
   return order == KernelOrder::quadratic ? 0.25 : 1.0 / 3.0;
 }
 
-KernelOrder kernel_order_from_name(const std::string& name);
 std::string kernel_name(KernelOrder order);
 
 /// 1D kernel N(r) and its derivative dN/dr, r in cell units.

@@ -18,11 +18,10 @@
 namespace viscompm::materials {
 
 enum class OldroydBUpdate { paper, spd, f_e };
-OldroydBUpdate oldroyd_b_update_from_name(const std::string& name);
 
 struct OldroydBParameters : ElasticParameters, NewtonianParameters {
   double weissenberg = 1.0;           ///< Wi
-  std::string strain_update = "paper";
+  OldroydBUpdate strain_update = OldroydBUpdate::paper;
 
   static const ParameterTable<OldroydBParameters>& table();
 };

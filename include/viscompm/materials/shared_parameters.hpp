@@ -33,11 +33,6 @@ void add_elastic_parameters(ParameterTable<P>& table, const std::string& energy)
 }
 
 enum class ViscosityConvention { paper, physical };
-inline ViscosityConvention viscosity_convention_from_name(const std::string& name) {
-  if (name == "paper") return ViscosityConvention::paper;
-  if (name == "physical") return ViscosityConvention::physical;
-  throw InputError("unknown viscosity convention '" + name + "' (expected paper or physical)");
-}
 /// c_N of the viscous potential Φ^N = c_N ε̂:ε̂ V^n for a step of size dt: μ^N as (5.11) (paper)
 /// or Δt η (physical, σ^N = 2ηε).
 inline double viscous_coefficient(ViscosityConvention convention, double viscosity, double dt) {
@@ -46,7 +41,7 @@ inline double viscous_coefficient(ViscosityConvention convention, double viscosi
 
 struct NewtonianParameters {
   double newtonian_viscosity = 0.0;              ///< μ^N (paper) or η (physical)
-  std::string viscosity_convention = "physical";
+  ViscosityConvention viscosity_convention = ViscosityConvention::physical;
 };
 
 /// Declares Newtonian viscosity and Viscosity convention on the table of a struct derived from
@@ -55,8 +50,9 @@ template <class P>
 void add_newtonian_parameters(ParameterTable<P>& table) {
   table.real(static_cast<double P::*>(&NewtonianParameters::newtonian_viscosity), "Newtonian viscosity", 0.0,
              Range::non_negative(), "μ^N of (5.11) in the paper convention [Pa], η in the physical one [Pa s]")
-      .string(static_cast<std::string P::*>(&NewtonianParameters::viscosity_convention), "Viscosity convention",
-              "physical", {"paper", "physical"},
+      .choice(static_cast<ViscosityConvention P::*>(&NewtonianParameters::viscosity_convention),
+              "Viscosity convention", ViscosityConvention::physical,
+              {{"paper", ViscosityConvention::paper}, {"physical", ViscosityConvention::physical}},
               "paper: Φ^N = μ^N ε̂:ε̂ V^n exactly as (5.11); physical: σ^N = 2ηε");
 }
 

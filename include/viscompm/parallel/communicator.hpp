@@ -46,6 +46,11 @@ class Communicator {
   int size_ = 1;
 };
 
+/// The memory of this machine in bytes, or its control group's limit (batch systems) if lower.
+double machine_memory();
+/// The memory each rank of `comm` may use: the machine's, shared among the ranks on it (collective).
+double memory_per_rank(const Communicator& comm);
+
 template <class T>
 std::vector<std::vector<T>> Communicator::exchange(const std::vector<std::vector<T>>& outgoing) const {
   static_assert(std::is_trivially_copyable_v<T>);

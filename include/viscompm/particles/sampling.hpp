@@ -1,5 +1,6 @@
 // Filling a solid with particles: a lattice of spacing Δx/n aligned with the grid (n particles
-// per cell and dimension), cut by the shape. Ids come from the lattice index, so they do not
+// per cell and dimension), cut by the shape and by the grid (a site outside the grid would be
+// clamped onto its faces). Ids come from the lattice index, so they do not
 // depend on the number of ranks; each rank keeps the particles it owns.
 #pragma once
 
@@ -20,7 +21,7 @@ struct BodySampling {
   int material_id = 0;
 };
 
-/// Number of lattice sites of a body's bounding box (the id range it reserves).
+/// Number of lattice sites of a body's bounding box inside the grid (the id range it reserves).
 std::int64_t lattice_size(const BodySampling& body, const grid::GridGeometry& grid);
 
 /// Appends the particles of `body` for which keep(x) is true, with ids id_offset + lattice index.

@@ -1,11 +1,13 @@
 // A scene: a Teuchos XML parameter list (inputs/scenes/*.xml) read into typed structs. Every
-// parameter is declared once (the tables below and each material model's own table); unknown
-// names, wrong types and out-of-range values fail at read time with InputError.
+// parameter is declared once (the tables in scene.cpp and each material model's own table);
+// unknown names, wrong types and out-of-range values fail at read time with InputError. Words
+// (kernel, transfer, contact, shape, walls, ...) become enums and names (materials, bodies,
+// models) indices when the file is read: nothing below scene/ compares configuration words.
 //
 //   Simulation  frames, frame rate, CFL, Δt bounds, gravity, transfer, kernel
 //   Grid        box, cell size, domain walls
 //   Newton      newton::NewtonSettings
-//   Solver      the solver XML file
+//   Solver      the solver XML file (none: the built-in default, inputs/solvers/jacobi_cg.xml)
 //   Materials   one sublist per material: "Model" and that model's parameters
 //   Bodies      one sublist per body: shape, material, sampling, initial velocity
 //   Colliders   one sublist per collider: shape, contact type, motion (translation, rotation,
@@ -19,9 +21,14 @@
 #include <string>
 #include <vector>
 
+#include "viscompm/boundary/colliders.hpp"
 #include "viscompm/core/parameters.hpp"
 #include "viscompm/core/shape.hpp"
+#include "viscompm/grid/bspline.hpp"
+#include "viscompm/linalg/linear_solver.hpp"
+#include "viscompm/materials/registry.hpp"
 #include "viscompm/newton/newton_settings.hpp"
+#include "viscompm/transfer/transfer.hpp"
 
 namespace viscompm::scene {
 
@@ -34,28 +41,35 @@ struct SimulationSettings {
   double time_step_growth = 1.5;     ///< the Δt cap grows by this factor per successful step
   double time_step_reduction = 0.5;  ///< Δt of a failed step is multiplied by this before the retry
   Vec3 gravity = Vec3(0.0, -9.81, 0.0);
-  std::string transfer = "apic";
+  transfer::Scheme transfer = transfer::Scheme::apic;
   double flip_ratio = 0.95;
-  std::string kernel = "quadratic";
+  grid::KernelOrder kernel = grid::KernelOrder::quadratic;
   static const ParameterTable<SimulationSettings>& table();
 };
+
+/// What happens to particles that reach the last cell of the grid.
+enum class OutsideParticles { clamp, remove };
 
 struct GridSettings {
   Vec3 lower_corner = Vec3::Zero();
   Vec3 upper_corner = Vec3::Ones();
   double cell_size = 0.05;
-  std::string walls = "separating";
+  boundary::ContactType walls = boundary::ContactType::separating;
   int wall_thickness = 2;
-  std::string outside_particles = "clamp";
+  OutsideParticles outside_particles = OutsideParticles::clamp;
   double rebalance_threshold = 1.25;
   int padding_cells = 0;
   double padding_lookahead = 8.0;
   static const ParameterTable<GridSettings>& table();
 };
 
+/// The solids a scene names; a disc (emitters) is a cylinder along the emitter's velocity, two
+/// cells long.
+enum class ShapeKind { box, sphere, cylinder, half_space, mesh, cuts, disc };
+
 /// The shape parameters bodies and colliders share.
 struct ShapeSettings {
-  std::string shape = "box";
+  ShapeKind shape = ShapeKind::box;
   Vec3 lower_corner = Vec3::Zero();
   Vec3 upper_corner = Vec3::Ones();
   Vec3 center = Vec3::Zero();
@@ -74,6 +88,7 @@ struct ShapeSettings {
 struct BodySettings : ShapeSettings {
   std::string name;
   std::string material;
+  int material_id = -1;            ///< index into SceneConfig::materials (link_names)
   int particles_per_cell = 2;
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
@@ -82,7 +97,7 @@ struct BodySettings : ShapeSettings {
 
 struct ColliderSettings : ShapeSettings {
   std::string name;
-  std::string contact = "sticky";
+  boundary::ContactType contact = boundary::ContactType::sticky;
   Vec3 velocity = Vec3::Zero();
   double start_time = 0.0;
   double stop_time = 1e30;
@@ -96,6 +111,7 @@ struct ColliderSettings : ShapeSettings {
 struct EmitterSettings : ShapeSettings {
   std::string name;
   std::string material;
+  int material_id = -1;            ///< index into SceneConfig::materials (link_names)
   Vec3 velocity = Vec3::UnitX();
   double mass_rate = 0.0;
   double start_time = 0.0;
@@ -107,12 +123,14 @@ struct EmitterSettings : ShapeSettings {
 struct RegionSettings : ShapeSettings {
   std::string name;
   std::string body;
+  int body_id = -1;                ///< index into SceneConfig::bodies (link_names)
   std::string material;
+  int material_id = -1;            ///< index into SceneConfig::materials (link_names)
   static const ParameterTable<RegionSettings>& table();
 };
 
 struct SolverFileSettings {
-  std::string file = "../solvers/jacobi_cg.xml";
+  std::string file;  ///< empty: the built-in default solver
   static const ParameterTable<SolverFileSettings>& table();
 };
 
@@ -127,7 +145,8 @@ struct OutputSettings {
 
 struct MaterialSettings {
   std::string name;
-  std::string model;
+  std::string model;                          ///< the registry's name of the model
+  const materials::ModelEntry* entry = nullptr;  ///< the model in the registry (link_names)
   ParameterValues values;  ///< validated against the model's declarations
 };
 
@@ -137,7 +156,7 @@ struct SceneConfig {
   SimulationSettings simulation;
   GridSettings grid;
   newton::NewtonSettings newton;
-  std::string solver_file;           ///< resolved path
+  std::string solver_file;           ///< resolved path; empty: the built-in default solver
   OutputSettings output;
   std::vector<MaterialSettings> materials;
   std::vector<BodySettings> bodies;
@@ -148,6 +167,8 @@ struct SceneConfig {
 
 /// The solid described by shape parameters (already validated by read_scene).
 Shape shape_of(const ShapeSettings& settings);
+/// The collider a scene describes: its shape, contact, rigid motion and surface velocity.
+boundary::Collider collider_of(const ColliderSettings& settings);
 
 /// A --set override: "Path/To/Parameter=value".
 struct Override {
@@ -156,8 +177,19 @@ struct Override {
   static Override parse(const std::string& text);
 };
 
-/// Reads and validates a scene; overrides are applied first (in order). Throws InputError.
+/// Reads and validates a scene; overrides are applied first (in order), and every value derived
+/// from others (mesh voxels and disc nozzles from Grid/Cell size) is computed after them. Throws
+/// InputError.
 SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides = {});
+
+/// Resolves the names a scene refers to — material names of bodies, emitters and regions, the
+/// bodies of regions, the models of materials — to indices and registry entries (read_scene does
+/// this; scenes built in code call it, or Simulation does). InputError naming the parameter.
+void link_names(SceneConfig& scene);
+
+/// The scene's solver configuration: its Solver/File, or the built-in default (the text of
+/// inputs/solvers/jacobi_cg.xml, compiled in) when the scene has none.
+linalg::SolverConfiguration solver_configuration(const SceneConfig& scene);
 
 /// Documentation of every scene parameter (for --help and doc/).
 std::string describe_scene_parameters();

@@ -1,4 +1,5 @@
-// The scene's solids as the physics layer sees them: colliders with their rigid motions and
+// The scene's solids as the physics layer sees them (the scene's names linked to indices,
+// scene::link_names): colliders with their rigid motions and
 // surface velocities, emitters with their nozzles' inflow, material regions of bodies.
 #pragma once
 
@@ -19,8 +20,8 @@ std::vector<boundary::Collider> make_colliders(const scene::SceneConfig& scene);
 std::vector<particles::Emitter> make_emitters(const scene::SceneConfig& scene, const grid::GridGeometry& grid,
                                               const materials::MaterialList& materials);
 std::vector<boundary::Inflow> make_inflows(const scene::SceneConfig& scene);
-/// The regions of body `body_name`.
-std::vector<particles::MaterialRegion> make_regions(const scene::SceneConfig& scene, const std::string& body_name,
+/// The regions of body number `body` (the scene's names linked: scene::link_names).
+std::vector<particles::MaterialRegion> make_regions(const scene::SceneConfig& scene, int body,
                                                     const materials::MaterialList& materials);
 
 }  // namespace viscompm::simulation

@@ -1,7 +1,9 @@
 // One time step of §5.5.1, in the order of the algorithm:
 //   layout → p2g → objective → newton (assemble, precondition, cg, line search) → g2p → advect
-// each phase under a named timer. A step whose Newton solve fails leaves the particles as they
-// were, so the caller can retry with a smaller Δt.
+// each phase under a named timer. The step works on the integrator's own copy of the particles
+// (with the neighbours' ghost particles appended to it, not to the caller's set) and replaces the
+// caller's particles only when it succeeds: a failed step (Newton, or a non-finite value) is
+// undone here, in one place, and the caller retries with a smaller Δt.
 #pragma once
 
 #include <memory>
@@ -28,7 +30,7 @@ struct PaddingSettings {
 struct IntegratorSettings {
   Vec3 gravity = Vec3::Zero();
   PaddingSettings padding;
-  bool delete_outside_particles = false;  ///< else clamp them to the last cell
+  bool delete_outside_particles = false;  ///< else clamp them to the last cell (Grid/Outside particles)
   transfer::TransferSettings transfer;
   newton::NewtonSettings newton;
 };
@@ -43,6 +45,8 @@ struct StepObjective {
 
 struct StepReport {
   double dt = 0.0;
+  bool taken = false;               ///< the particles were advanced (else they are as they were)
+  std::string failure;              ///< why not (empty when taken or interrupted)
   newton::NewtonReport newton;
   bool partition_rebuilt = false;   ///< the node partition (and the Hessian's graph) was built anew
   std::size_t ghost_particles = 0;  ///< neighbours' particles copied here
@@ -60,12 +64,14 @@ class TimeIntegrator {
                  const materials::MaterialList& materials, const boundary::Boundary& boundary,
                  const linalg::SolverConfiguration& solver);
 
-  /// Advances `particles` from time t by dt. If Newton fails, particles are unchanged (only
-  /// reordered) and the report says why. A non-empty `dump_prefix` writes the first Newton
-  /// system to PREFIX.mtx / PREFIX_rhs.mtx.
+  /// Advances `particles` from time t by dt (collective). They change only when the step is
+  /// taken: if Newton fails or is interrupted, or the step leaves a non-finite value on any rank,
+  /// they stay exactly as they were and the report says why. A non-empty `dump_prefix` writes
+  /// the first Newton system to PREFIX.mtx / PREFIX_rhs.mtx.
   StepReport step(particles::ParticleSet& particles, double t, double dt, const std::string& dump_prefix = "");
 
-  // The phases of step(), public for tests and the solver study.
+  // The phases of step(), public for tests and the solver study (step() runs them on its own
+  // copy of the particles; called directly, they work on the set they are given).
   /// Sorts particles by cell, rebuilds the node partition if a particle left it (padding for
   /// steps of `dt`), and appends the ghost particles to `particles` (drop_ghosts removes them).
   /// Returns true if the partition was rebuilt.
@@ -128,6 +134,10 @@ class TimeIntegrator {
   newton::NewtonSolver newton_;
   NodeScalarField mass_;
   NodeVectorField momentum_, v_old_;
+  particles::ParticleSet working_;  ///< the particles of the step in progress, ghosts appended
+
+  /// True on every rank if no rank holds a non-finite particle value.
+  bool finite(const particles::ParticleSet& particles) const;
 };
 
 }  // namespace viscompm::simulation

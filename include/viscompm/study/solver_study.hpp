@@ -21,16 +21,20 @@
 
 namespace viscompm::study {
 
+enum class StudyMode { systems, steps };
+enum class TimeStepUnit { elastic_cfl, seconds };
+enum class RightHandSide { newton, random };
+
 struct StudySettings {
-  std::string mode = "systems";       ///< systems | steps
-  std::string scene;                  ///< scene XML, relative to the study file
+  StudyMode mode = StudyMode::systems;
+  std::string scene;                  ///< scene XML (read_study resolves it against the study file)
   RealList cell_sizes;                ///< resolutions Δx [m] (systems)
   RealList time_steps;                ///< Δt, in `time_step_unit` (systems)
-  std::string time_step_unit = "elastic CFL";
+  TimeStepUnit time_step_unit = TimeStepUnit::elastic_cfl;
   double time = 0.0;                  ///< advance the scene to this time first [s] (systems)
-  std::string right_hand_side = "newton";  ///< newton: −∇E; random: a fixed random load (systems)
-  StringList solvers;                 ///< solver XML files, relative to the study file
-  StringList matrix_market_files;     ///< extra problems, relative to the study file (systems)
+  RightHandSide right_hand_side = RightHandSide::newton;  ///< −∇E, or a fixed random load (systems)
+  StringList solvers;                 ///< solver XML files (resolved against the study file)
+  StringList matrix_market_files;     ///< extra problems (resolved against the study file; systems)
   int repetitions = 1;                ///< solves per (problem, configuration); the fastest is kept
   int frames = 2;                     ///< frames per configuration (steps)
   StringList scene_overrides;         ///< "Path/To/Parameter=value" applied to the scene (steps)
@@ -48,10 +52,14 @@ struct StudySettings {
   static const ParameterTable<StudySettings>& table();
 };
 
-/// Reads and validates a study file (InputError with file and parameter on bad input).
+/// Reads and validates a study file (InputError with file and parameter on bad input): its
+/// scene at every cell size, its solver files and Configurations; the paths it names resolved
+/// against it, a missing one naming the study file and the parameter (Scene, Solvers, ...).
 StudySettings read_study(const std::string& file, const std::vector<scene::Override>& overrides);
 
-/// Runs the study, logging progress on rank 0. Returns the number of rows written.
+/// Runs the study, logging progress on rank 0. Returns the number of rows written. Every input
+/// (MatrixMarket files, the scene's memory at every cell size) is read and checked before an
+/// output file is opened, so that bad input (InputError) leaves earlier results as they were.
 int run_study(const StudySettings& settings, const std::string& study_file, const parallel::Communicator& comm,
               std::ostream& log);
 

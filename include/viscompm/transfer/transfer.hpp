@@ -13,7 +13,6 @@
 namespace viscompm::transfer {
 
 enum class Scheme { apic, pic_flip };
-Scheme scheme_from_name(const std::string& name);
 
 struct TransferSettings {
   Scheme scheme = Scheme::apic;

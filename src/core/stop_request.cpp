@@ -1,8 +1,8 @@
-#include "viscompm/simulation/stop_request.hpp"
+#include "viscompm/core/stop_request.hpp"
 
 #include <csignal>
 
-namespace viscompm::simulation {
+namespace viscompm {
 
 namespace {
 volatile std::sig_atomic_t received = 0;
@@ -33,4 +33,4 @@ int stop_signal() { return received; }
 
 void clear_stop_signal() { received = 0; }
 
-}  // namespace viscompm::simulation
+}  // namespace viscompm

@@ -2,11 +2,12 @@
 // is pre-empted), SIGINT (Ctrl-C) and SIGUSR1 (which Open MPI's mpirun forwards to the ranks
 // without ending the job itself). The handler only records the signal; Simulation::run looks at
 // it before every Newton iteration (abandoning the step) and after every step, agrees on it
-// across ranks (a signal may reach only some of them), writes a checkpoint and returns. A second
-// signal ends the process at once.
+// across ranks (a signal may reach only some of them), writes a checkpoint and returns. The long
+// computations of setting a run up and of its output (OpenVDB's level sets) look at it too and
+// end with StopRequested (core/error.hpp). A second signal ends the process at once.
 #pragma once
 
-namespace viscompm::simulation {
+namespace viscompm {
 
 /// Installs the handlers for SIGTERM, SIGINT and SIGUSR1, and ignores SIGXFSZ (a file-size limit then
 /// fails the write, which ends the run with exit code 3, instead of killing the process).
@@ -16,4 +17,4 @@ int stop_signal();
 /// Forgets a received signal (tests).
 void clear_stop_signal();
 
-}  // namespace viscompm::simulation
+}  // namespace viscompm
