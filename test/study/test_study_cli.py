@@ -196,12 +196,12 @@ if len(rows) == 3:
     check(all(float(r["cell_size"]) == 0.06 for r in rows), "cell_size: the scene override's")
 # The steps mode at two cell sizes: one row per configuration and size, the size as asked (a
 # Cell sizes entry overrides the scene overrides' Grid/Cell size).
-result = run(args.study, steps_study, "--output", out + "_sizes", "--set", "Cell sizes={0.075, 0.1}",
+result = run(args.study, steps_study, "--output", out + "_sizes", "--set", "Cell sizes={0.06, 0.075}",
              "--set", "Frames=1")
 check(result.returncode == 0, f"steps study at two sizes exits 0: {result.stderr[-1500:]}")
 rows = list(csv.DictReader(open(os.path.join(out + "_sizes", "steps.csv")))) if result.returncode == 0 else []
 check([(r["configuration"], float(r["cell_size"])) for r in rows] ==
-      [(c, h) for h in (0.075, 0.1) for c in ("exact Newton", "once per step", "paper")], f"steps.csv rows {rows}")
+      [(c, h) for h in (0.06, 0.075) for c in ("exact Newton", "once per step", "paper")], f"steps.csv rows {rows}")
 if len(rows) == 6:
     check(int(rows[0]["cg_iterations"]) != int(rows[3]["cg_iterations"]), "the sizes are different problems")
 # A steps study whose configuration names a Newton parameter that does not exist is bad input.
