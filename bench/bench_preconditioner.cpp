@@ -27,6 +27,13 @@ int main(int argc, char** argv) {
   bool after_separator = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "--help") {
+      if (comm.rank() == 0)
+        std::printf("usage: bench_preconditioner SOLVER.xml... -- MATRIX.mtx...\n"
+                    "  per solver file and MatrixMarket system: set-up, CG iterations and time, one SpMV, one\n"
+                    "  preconditioner application and their ratio (CSV on standard output)\n");
+      return 0;
+    }
     if (arg == "--") after_separator = true;
     else (after_separator ? matrices : solvers).push_back(arg);
   }

@@ -48,6 +48,8 @@ class AssembledHessian : public HessianOperator {
 
  private:
   void fill(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project);
+  void add_free_cell(const int* nodes, const implicit::ElementHessian& element, int owned, int K);
+  void add_inertia(const implicit::IncrementalPotential& potential, int owned);
 
   const NodeSpace& space_;
   std::uint64_t graph_version_ = 0;
@@ -137,49 +139,61 @@ void AssembledHessian::fill(const implicit::IncrementalPotential& potential, con
         }
       return;
     }
-    // The common case: read the element's lanes directly into the rows of a and of b.
-    for (int a = 0; a < K; ++a) {
-      const int i = nodes[a];
-      const bool row_a = i < owned;
-      const double* e[3][3];
+    add_free_cell(nodes, element, owned, K);
+  });
+  add_inertia(potential, owned);
+}
+
+// A cell whose stencil has no constrained node: the element's lanes read directly into the rows
+// of a and of b.
+void AssembledHessian::add_free_cell(const int* nodes, const implicit::ElementHessian& element, int owned, int K) {
+  const parallel::NodePartition& partition = space_.partition();
+  double* values = values_.data();
+  for (int a = 0; a < K; ++a) {
+    const int i = nodes[a];
+    const bool row_a = i < owned;
+    const double* e[3][3];
+    for (int sigma = 0; sigma < 3; ++sigma)
+      for (int tau = 0; tau < 3; ++tau) e[sigma][tau] = element.lanes(a, sigma, tau);
+    double* rows_a[3] = {nullptr, nullptr, nullptr};
+    const std::int16_t* slots_a = nullptr;
+    if (row_a) {
+      for (int sigma = 0; sigma < 3; ++sigma) rows_a[sigma] = values + row_offsets_(3 * i + sigma);
+      slots_a = partition.window_slots(i);
+    }
+    const int* positions_a = pair_positions_.data() + a * K;
+    // Diagonal block, symmetrised.
+    if (row_a) {
+      const std::size_t slot = 3 * static_cast<std::size_t>(slots_a[positions_a[a]]);
       for (int sigma = 0; sigma < 3; ++sigma)
-        for (int tau = 0; tau < 3; ++tau) e[sigma][tau] = element.lanes(a, sigma, tau);
-      double* rows_a[3] = {nullptr, nullptr, nullptr};
-      const std::int16_t* slots_a = nullptr;
+        for (int tau = 0; tau < 3; ++tau) rows_a[sigma][slot + tau] += 0.5 * (e[sigma][tau][a] + e[tau][sigma][a]);
+    }
+    for (int b = a + 1; b < K; ++b) {
+      const int j = nodes[b];
       if (row_a) {
-        for (int sigma = 0; sigma < 3; ++sigma) rows_a[sigma] = values + row_offsets_(3 * i + sigma);
-        slots_a = partition.window_slots(i);
-      }
-      const int* positions_a = pair_positions_.data() + a * K;
-      // Diagonal block, symmetrised.
-      if (row_a) {
-        const std::size_t slot = 3 * static_cast<std::size_t>(slots_a[positions_a[a]]);
-        for (int sigma = 0; sigma < 3; ++sigma)
-          for (int tau = 0; tau < 3; ++tau) rows_a[sigma][slot + tau] += 0.5 * (e[sigma][tau][a] + e[tau][sigma][a]);
-      }
-      for (int b = a + 1; b < K; ++b) {
-        const int j = nodes[b];
-        if (row_a) {
-          const std::size_t slot = 3 * static_cast<std::size_t>(slots_a[positions_a[b]]);
-          for (int sigma = 0; sigma < 3; ++sigma) {
-            double* row = rows_a[sigma] + slot;
-            row[0] += e[sigma][0][b];
-            row[1] += e[sigma][1][b];
-            row[2] += e[sigma][2][b];
-          }
+        const std::size_t slot = 3 * static_cast<std::size_t>(slots_a[positions_a[b]]);
+        for (int sigma = 0; sigma < 3; ++sigma) {
+          double* row = rows_a[sigma] + slot;
+          row[0] += e[sigma][0][b];
+          row[1] += e[sigma][1][b];
+          row[2] += e[sigma][2][b];
         }
-        if (j < owned) {
-          const std::size_t slot = 3 * static_cast<std::size_t>(partition.window_slots(j)[pair_positions_[b * K + a]]);
-          for (int tau = 0; tau < 3; ++tau) {
-            double* row = values + row_offsets_(3 * j + tau) + slot;
-            row[0] += e[0][tau][b];
-            row[1] += e[1][tau][b];
-            row[2] += e[2][tau][b];
-          }
+      }
+      if (j < owned) {
+        const std::size_t slot = 3 * static_cast<std::size_t>(partition.window_slots(j)[pair_positions_[b * K + a]]);
+        for (int tau = 0; tau < 3; ++tau) {
+          double* row = values + row_offsets_(3 * j + tau) + slot;
+          row[0] += e[0][tau][b];
+          row[1] += e[1][tau][b];
+          row[2] += e[2][tau][b];
         }
       }
     }
-  });
+  }
+}
+
+void AssembledHessian::add_inertia(const implicit::IncrementalPotential& potential, int owned) {
+  double* values = values_.data();
   // Inertia m_i on the diagonal; nodes without mass (the partition's padding) get identity rows
   // scaled like an average node, so that the matrix stays SPD and their dv is zero.
   const double scale = massless_row_scale(potential, space_.comm());
