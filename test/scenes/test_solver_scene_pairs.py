@@ -15,6 +15,7 @@ import shutil
 import subprocess
 import sys
 import time
+import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "support"))
 from script_checks import check, finish, program_arguments  # noqa: E402
@@ -39,12 +40,17 @@ def documented_incompatibility(solver, line):
     return solver in one_rank and args.ranks > 1 and os.path.basename(solver) in line and "one rank" in line
 
 
-# Two steps: a frame of 0.6 ms with steps of at most 0.3 ms (more if the CFL condition asks): steps
-# short enough for the stiff scenes' systems to stay cheap for the slowest solver files
-# (unpreconditioned CG on the pie: 30 s), long enough for the pie's Galerkin product to fail with
-# muelu_cg.xml as it does at the scene's own steps (it does not below 0.25 ms).
-two_steps = ["--frames", "1", "--set", "Simulation/Frame rate=1666.6666666666667", "--set",
-             "Simulation/Max time step=3e-4"]
+# Two steps: a frame of 0.6 ms with steps of at most 0.3 ms (more if the CFL condition asks): long
+# enough for the pie's Galerkin product to fail with muelu_cg.xml as it does at the scene's own steps
+# (it does not below 0.25 ms). Solver files without a preconditioner take steps of 0.1 ms: at 0.3 ms
+# their CG on the pie needs up to 20 000 iterations per solve (30 s on an idle machine, over the
+# 240-s limit on 2 shared cores at load 7; 12 s at 0.1 ms at that load).
+def two_steps(solver):
+    unpreconditioned = any(p.get("name") == "Preconditioner" and p.get("value") == "none"
+                           for p in ET.parse(solver).getroot().iter("Parameter"))
+    step = 1e-4 if unpreconditioned else 3e-4
+    return ["--frames", "1", "--set", f"Simulation/Frame rate={1.0 / (2 * step)!r}", "--set",
+            f"Simulation/Max time step={step!r}"]
 
 
 def run_pair(pair):
@@ -53,7 +59,7 @@ def run_pair(pair):
     name = f"{os.path.relpath(scene, args.inputs)} + {os.path.relpath(solver, args.inputs)}"
     out = os.path.join(args.workdir, name.replace("/", "_").replace(" + ", "__"))
     command = shlex.split(args.mpiexec) + ["-np", str(args.ranks), args.viscompm, scene, "--solver", solver,
-                                           "--output", out, *two_steps]
+                                           "--output", out, *two_steps(solver)]
     started = time.time()
     try:
         result = subprocess.run(command, capture_output=True, text=True, timeout=240)
