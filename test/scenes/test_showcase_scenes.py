@@ -2,7 +2,8 @@
 """Every showcase scene (inputs/scenes/paper/showcase/) is its paper scene at another size: it reads
 and validates (viscompm --frames 0 exits 0), and it differs from inputs/scenes/paper/NAME.xml only
 in the parameters doc/scenes.md names (Grid/Cell size, Simulation/Frames, Solver/File, Newton's
-Linear tolerance and Hessian update, Output's Directory and Surface voxel size), its meshes and
+strategy: Linear tolerance, Hessian update, Hessian projection, Preconditioner update; Output's
+Directory and Surface voxel size), its meshes and
 solver file being the same files."""
 import glob
 import os
@@ -14,6 +15,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.p
 from script_checks import check, finish, program_arguments  # noqa: E402
 
 ALLOWED = {"Grid/Cell size", "Simulation/Frames", "Solver/File", "Newton/Linear tolerance", "Newton/Hessian update",
+           "Newton/Hessian projection", "Newton/Preconditioner update",
            "Output/Directory", "Output/Surface voxel size"}
 
 
