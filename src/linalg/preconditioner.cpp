@@ -60,18 +60,10 @@ parts_type grid_line_parts(const SystemGrid& grid, int max_nodes) {
 // damping from the matrix it smooths.
 class GridLines {
  public:
-  /// The smoother's Ifpack2 list: the configured one with the blocks of `grid` — the runs of owned
-  /// grid nodes along each axis, as blocks of dofs (3 per node, consecutive).
+  /// The smoother's Ifpack2 list: the configured one with the blocks of `grid`.
   const Teuchos::ParameterList& prepare(const Teuchos::ParameterList& configured, const SystemGrid& grid, int max_nodes) {
-    parts_type parts;
-    for (const auto& line : grid::node_lines(grid.owned_nodes, max_nodes)) {
-      Teuchos::ArrayRCP<local_ordinal_type> dofs(3 * line.size());
-      for (std::size_t k = 0; k < line.size(); ++k)
-        for (int d = 0; d < 3; ++d) dofs[3 * k + d] = static_cast<local_ordinal_type>(3 * line[k] + d);
-      parts.push_back(dofs);
-    }
     list_ = configured;
-    list_.set("partitioner: parts", parts);
+    list_.set("partitioner: parts", grid_line_parts(grid, max_nodes));
     eigenvector_ = Teuchos::null;
     return list_;
   }

@@ -225,14 +225,11 @@ bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, 
   linalg::LinearSolveReport& solve = report.linear_solves.back();
   {
     Teuchos::TimeMonitor t(cg_timer());
-    const linalg::LinearSolveReport cg = system_.solve(rhs, dv, tolerance);
-    solve.iterations = cg.iterations;
-    solve.relative_residual = cg.relative_residual;
-    solve.solve_seconds = cg.solve_seconds;
-    solve.converged = cg.converged;
-    solve.tolerance = cg.tolerance;
-    solve.preconditioner = cg.preconditioner;
-    solve.failure = cg.failure;
+    // The solve's report, with this attempt's assembly and set-up times kept.
+    const double operator_seconds = solve.operator_seconds, setup_seconds = solve.setup_seconds;
+    solve = system_.solve(rhs, dv, tolerance);
+    solve.operator_seconds = operator_seconds;
+    solve.setup_seconds = setup_seconds;
   }
   report.projected_solves += attempt.project;
   rules_.solved(solve.iterations, solve.tolerance);
