@@ -82,22 +82,21 @@ void validate_grid_line_smoother(const SolverConfiguration::Impl& impl, const st
     }
   }
   if (smoother == nullptr)
-    throw InputError(origin + ": parameter 'Smoother blocks': grid lines need a BLOCK_RELAXATION smoother on the fine "
+    throw parameter_error(origin, "Smoother blocks", "grid lines need a BLOCK_RELAXATION smoother on the fine "
                      "level: Ifpack2 type BLOCK_RELAXATION, or MueLu's \"level 0\" list with smoother: type BLOCK "
                      "RELAXATION and its smoother: params");
   for (const char* name : {"partitioner: local parts", "partitioner: map", "partitioner: parts",
                            "relaxation: damping factor"})
     if (smoother->isParameter(name))
-      throw InputError(origin + ": parameter '" + where + "/" + name +
-                       "': set by viscompm when Smoother blocks = grid lines");
+      throw parameter_error(origin, where + "/" + name, "set by viscompm when Smoother blocks = grid lines");
   auto word = [smoother](const char* name, const char* otherwise) {
     return smoother->isType<std::string>(name) ? smoother->get<std::string>(name) : std::string(otherwise);
   };
   if (word("partitioner: type", "") != "user")
-    throw InputError(origin + ": parameter '" + where + "/partitioner: type': must be 'user' when Smoother blocks = grid lines");
+    throw parameter_error(origin, where + "/partitioner: type", "must be 'user' when Smoother blocks = grid lines");
   const std::string relaxation = word("relaxation: type", "Jacobi");
   if (relaxation != "Jacobi" && relaxation != "Symmetric Gauss-Seidel")
-    throw InputError(origin + ": parameter '" + where + "/relaxation: type': must be 'Jacobi' or 'Symmetric "
+    throw parameter_error(origin, where + "/relaxation: type", "must be 'Jacobi' or 'Symmetric "
                      "Gauss-Seidel' when Smoother blocks = grid lines (the blocks overlap: their additive or symmetric "
                      "multiplicative combination is symmetric)");
 }
@@ -125,7 +124,7 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   const bool library_preconditioner =
       s.preconditioner == PreconditionerKind::ifpack2 || s.preconditioner == PreconditionerKind::muelu;
   if (s.operator_form == OperatorForm::matrix_free && library_preconditioner)
-    throw InputError(origin + ": parameter 'Preconditioner': " + preconditioner_word +
+    throw parameter_error(origin, "Preconditioner", preconditioner_word +
                      " needs the assembled matrix (Operator = assembled)");
   if (s.preconditioner == PreconditionerKind::ifpack2)
     validate_ifpack2_parameters(s.ifpack2_type, *impl->preconditioner_parameters, origin, "Ifpack2 type",
@@ -133,10 +132,10 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
   if (s.preconditioner == PreconditionerKind::muelu)
     validate_muelu_parameters(*impl->preconditioner_parameters, origin, preconditioner_sublist);
   if (!library_preconditioner && impl->preconditioner_parameters->numParams() > 0)
-    throw InputError(origin + ": parameter '" + preconditioner_sublist + "': " + preconditioner_word +
+    throw parameter_error(origin, preconditioner_sublist, preconditioner_word +
                      " takes no parameters");
   if (s.prolongation != Prolongation::algebraic && s.preconditioner != PreconditionerKind::muelu)
-    throw InputError(origin + ": parameter 'Prolongation': geometric prolongators are for Preconditioner = MueLu");
+    throw parameter_error(origin, "Prolongation", "geometric prolongators are for Preconditioner = MueLu");
   if (s.smoother_blocks == SmootherBlocks::grid_lines) validate_grid_line_smoother(*impl, origin);
   if (s.label.empty()) {
     s.label = (s.operator_form == OperatorForm::matrix_free ? "matrix-free " : "") +
@@ -170,7 +169,7 @@ const std::string& SolverConfiguration::label() const { return impl_->settings.l
 void SolverConfiguration::check_rank_count(int ranks) const {
   const int most = impl_->settings.max_ranks;
   if (most > 0 && ranks > most)
-    throw InputError(origin() + ": parameter 'Ranks': this solver file runs on at most " + std::to_string(most) +
+    throw parameter_error(origin(), "Ranks", "this solver file runs on at most " + std::to_string(most) +
                      (most == 1 ? " rank (one rank only)" : " ranks") + ", the run has " + std::to_string(ranks));
 }
 

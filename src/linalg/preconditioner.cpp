@@ -177,7 +177,7 @@ class Ifpack2Preconditioner : public Preconditioner {
     if (pattern_changed || prec_.is_null()) {
       prec_ = Ifpack2::Factory::create<row_matrix_type>(settings.ifpack2_type, A);
       if (prec_.is_null())
-        throw InputError(config_.origin() + ": parameter 'Ifpack2 type': unknown Ifpack2 preconditioner '" +
+        throw parameter_error(config_.origin(), "Ifpack2 type", "unknown Ifpack2 preconditioner '" +
                          settings.ifpack2_type + "'");
       Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
       // 3×3 point-block relaxation: one block per node (a node's three dofs are consecutive).
@@ -321,7 +321,7 @@ class MueLuPreconditioner : public Preconditioner {
   // which then aggregates anyway; built as below, the interpreter sees the P and uses it.
   void setup_geometric(const Teuchos::RCP<crs_matrix_type>& A, Teuchos::ParameterList& params,
                        const NearNullspace& modes) {
-    if (!modes.grid) throw InputError(config_.origin() + ": parameter 'Prolongation': geometric prolongators need the "
+    if (!modes.grid) throw parameter_error(config_.origin(), "Prolongation", "geometric prolongators need the "
                                       "grid of the system (a scene, or a MatrixMarket dump with node coordinates)");
     const auto comm = A->getRowMap()->getComm();
     const parallel::Communicator communicator(*Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm)->getRawMpiComm());

@@ -21,10 +21,9 @@
 namespace viscompm::linalg {
 
 namespace {
-using row_matrix_type = Tpetra::RowMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 
 [[noreturn]] void fail(const std::string& origin, const std::string& path, const std::string& reason) {
-  throw InputError(origin + ": parameter '" + path + "': " + reason);
+  throw parameter_error(origin, path, reason);
 }
 
 std::string joined(const std::string& path, const std::string& name) { return path.empty() ? name : path + "/" + name; }
@@ -210,7 +209,7 @@ void validate_ifpack2_parameters(const std::string& type, const Teuchos::Paramet
   check_word(given, "partitioner: type", {"linear", "line", "user"}, origin, path);
   // The preconditioner of that type, without a matrix, checks the values itself: its list of
   // valid parameters with validators where it has one, and setParameters.
-  Teuchos::RCP<Ifpack2::Preconditioner<scalar_type, local_ordinal_type, global_ordinal_type, node_type>> prec;
+  Teuchos::RCP<ifpack2_preconditioner_type> prec;
   try {
     prec = Ifpack2::Factory::create<row_matrix_type>(type, Teuchos::null);
   } catch (const std::exception&) {
@@ -291,7 +290,7 @@ void validate_muelu_parameters(const Teuchos::ParameterList& given, const std::s
   copy.remove("user data", false);
   copy.set("verbosity", std::string("none"));
   try {
-    MueLu::ParameterListInterpreter<scalar_type, local_ordinal_type, global_ordinal_type, node_type> interpreter(
+    muelu_interpreter_type interpreter(
         copy, Teuchos::DefaultComm<int>::getComm());
   } catch (const std::exception& e) {
     fail_from_library(e, given, origin, path);
