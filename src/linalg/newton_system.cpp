@@ -70,7 +70,8 @@ void NewtonSystem::Impl::from_owned(const multivector_type& owned, NodeVectorFie
 }
 
 NewtonSystem::NewtonSystem(const NodeSpace& space, const SolverConfiguration& config)
-    : impl_((config.check_rank_count(space.comm().size()), std::make_unique<Impl>(space, config))) {
+    : impl_(std::make_unique<Impl>(space, config)) {
+  config.check_rank_count(space.comm().size());  // before any graph is built or system solved
   if (space.version() > 0) build_pattern();
 }
 
