@@ -52,6 +52,22 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
         .real(&S::line_damping, "Line damping", 1.5, Range::open_closed(0.0, 2.0),
               "grid lines: the block Jacobi damping is this over the largest eigenvalue of (blocks⁻¹ H), "
               "estimated by power iterations at each set-up (< 2 for a convergent smoother)")
+        .integer(&S::line_levels, "Line levels", 1, Range::closed(1, 31),
+                 "grid lines on a geometric hierarchy: the finest this many levels smooth on the lines of their "
+                 "own grid (the coarse levels' smoothers as level 0's, each with its own damping)")
+        .choice(&S::cycle, "Cycle", Cycle::muelu, {{"MueLu", Cycle::muelu}, {"lean", Cycle::lean}},
+                "MueLu: the hierarchy's V-cycle as MueLu applies it; lean: viscompm applies the fine level (the "
+                "grid-line smoother with its own factored blocks, the products with the operator CG uses) and "
+                "MueLu the levels below (needs Smoother blocks = grid lines)")
+        .choice(&S::deflation, "Deflation", Deflation::none,
+                {{"none", Deflation::none}, {"stiff bodies", Deflation::stiff_bodies}},
+                "stiff bodies: the 6 rigid motions of every stiff body (connected material whose elastic waves "
+                "cross Stiff CFL cells or more in a step) are solved exactly beside the preconditioner (balancing "
+                "deflation): the softest modes of stiff pieces in soft material, which no grid hierarchy holds")
+        .real(&S::stiff_cfl, "Stiff CFL", 30.0, Range::positive(),
+              "deflation: a material is stiff where c Δt/Δx reaches this (c its fastest elastic wave)")
+        .integer(&S::max_stiff_bodies, "Max stiff bodies", 64, Range::closed(1, 10000),
+                 "deflation: the largest this many stiff bodies are deflated (6 columns each)")
         .integer(&S::max_ranks, "Ranks", 0, Range::at_least(0),
                  "the most ranks this configuration runs on (0: any; 1 for preconditioners that only work on "
                  "one rank): a run on more is bad input");
@@ -62,15 +78,22 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
 
 namespace {
 constexpr const char* krylov_sublist = "Krylov parameters";
+constexpr const char* block_relaxation = "BLOCK_RELAXATION";
+
+// Ifpack2's (and MueLu's) three spellings of its block relaxation.
+bool is_block_relaxation(const std::string& type) {
+  return type == block_relaxation || type == "BLOCK RELAXATION" || type == "BLOCKRELAXATION";
+}
 constexpr const char* preconditioner_sublist = "Preconditioner parameters";
 
 // Smoother blocks = grid lines: the fine level's smoother must be a block relaxation whose blocks
-// viscompm can give (partitioner "user"); viscompm sets the blocks and the damping itself.
-void validate_grid_line_smoother(const SolverConfiguration::Impl& impl, const std::string& origin) {
+// viscompm can give (partitioner "user"); viscompm sets the blocks and the damping itself. Returns
+// how it combines them.
+BlockCombination validate_grid_line_smoother(const SolverConfiguration::Impl& impl, const std::string& origin) {
   const SolverSettings& s = impl.settings;
   const Teuchos::ParameterList* smoother = nullptr;
   std::string where;
-  if (s.preconditioner == PreconditionerKind::ifpack2 && is_block_relaxation(s.ifpack2_type)) {
+  if (s.preconditioner == PreconditionerKind::ifpack2 && s.ifpack2_kind == Ifpack2Kind::block_relaxation) {
     smoother = impl.preconditioner_parameters.get();
     where = preconditioner_sublist;
   } else if (s.preconditioner == PreconditionerKind::muelu && impl.preconditioner_parameters->isSublist("level 0")) {
@@ -95,10 +118,11 @@ void validate_grid_line_smoother(const SolverConfiguration::Impl& impl, const st
   if (word("partitioner: type", "") != "user")
     throw parameter_error(origin, where + "/partitioner: type", "must be 'user' when Smoother blocks = grid lines");
   const std::string relaxation = word("relaxation: type", "Jacobi");
-  if (relaxation != "Jacobi" && relaxation != "Symmetric Gauss-Seidel")
-    throw parameter_error(origin, where + "/relaxation: type", "must be 'Jacobi' or 'Symmetric "
-                     "Gauss-Seidel' when Smoother blocks = grid lines (the blocks overlap: their additive or symmetric "
-                     "multiplicative combination is symmetric)");
+  if (relaxation == "Jacobi") return BlockCombination::jacobi;
+  if (relaxation == "Symmetric Gauss-Seidel") return BlockCombination::symmetric_gauss_seidel;
+  throw parameter_error(origin, where + "/relaxation: type", "must be 'Jacobi' or 'Symmetric "
+                   "Gauss-Seidel' when Smoother blocks = grid lines (the blocks overlap: their additive or symmetric "
+                   "multiplicative combination is symmetric)");
 }
 
 std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& list, const std::string& origin) {
@@ -108,6 +132,10 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
       params::read_parameters(list, SolverSettings::table().specs(), origin, "", {krylov_sublist, preconditioner_sublist});
   impl->settings = SolverSettings::table().parse(values);
   SolverSettings& s = impl->settings;
+  if (is_block_relaxation(s.ifpack2_type)) {
+    s.ifpack2_type = block_relaxation;
+    s.ifpack2_kind = Ifpack2Kind::block_relaxation;
+  }
 
   impl->krylov_parameters = Teuchos::rcp(new Teuchos::ParameterList(
       list.isSublist(krylov_sublist) ? list.sublist(krylov_sublist) : Teuchos::ParameterList()));
@@ -136,7 +164,15 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
                      " takes no parameters");
   if (s.prolongation != Prolongation::algebraic && s.preconditioner != PreconditionerKind::muelu)
     throw parameter_error(origin, "Prolongation", "geometric prolongators are for Preconditioner = MueLu");
-  if (s.smoother_blocks == SmootherBlocks::grid_lines) validate_grid_line_smoother(*impl, origin);
+  if (s.smoother_blocks == SmootherBlocks::grid_lines) s.line_combination = validate_grid_line_smoother(*impl, origin);
+  if (s.cycle == Cycle::lean && (s.preconditioner != PreconditionerKind::muelu || s.smoother_blocks != SmootherBlocks::grid_lines))
+    throw parameter_error(origin, "Cycle", "the lean cycle needs Preconditioner = MueLu and Smoother blocks = grid lines");
+  if (s.line_levels > 1 && (s.smoother_blocks != SmootherBlocks::grid_lines || s.prolongation == Prolongation::algebraic))
+    throw parameter_error(origin, "Line levels", "coarse grid lines need Smoother blocks = grid lines and a geometric "
+                                                 "Prolongation (the coarse levels of an algebraic hierarchy are no grids)");
+  const Teuchos::ParameterList& preconditioner_list = *impl->preconditioner_parameters;
+  s.muelu_reuse = s.preconditioner == PreconditionerKind::muelu && preconditioner_list.isType<std::string>("reuse: type") &&
+                  preconditioner_list.get<std::string>("reuse: type") != "none";
   if (s.label.empty()) {
     s.label = (s.operator_form == OperatorForm::matrix_free ? "matrix-free " : "") +
               (s.preconditioner == PreconditionerKind::ifpack2 ? "Ifpack2 " + s.ifpack2_type : preconditioner_word);

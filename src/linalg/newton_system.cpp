@@ -3,8 +3,12 @@
 #include <MatrixMarket_Tpetra.hpp>
 #include <algorithm>
 #include <chrono>
+#include <optional>
+#include <stdexcept>
 
+#include "deflation.hpp"
 #include "krylov.hpp"
+#include "viscompm/implicit/stiff_bodies.hpp"
 #include "preconditioner.hpp"
 #include "hessian_operator.hpp"
 #include "matrix_market_io.hpp"
@@ -24,10 +28,20 @@ struct NewtonSystem::Impl {
   std::unique_ptr<HessianOperator> hessian;
   std::unique_ptr<Preconditioner> preconditioner;
   KrylovSolver krylov;
-  bool pattern_changed = true;  // since the last preconditioner set-up
-  bool preconditioned = false;  // for the current pattern
-  std::uint64_t pattern_version = 0;
+  std::uint64_t pattern_version = 0;               // the NodeSpace version of H's pattern
+  std::optional<std::uint64_t> preconditioned_for;  // the pattern of the last preconditioner set-up
   NearNullspace modes;
+  Teuchos::RCP<multivector_type> stiff_modes;           // Deflation: Z of the last assembly (null: none)
+  Teuchos::RCP<DeflatedPreconditioner> deflated;        // the preconditioner with Z deflated
+  int stiff_bodies = 0;
+
+  /// The operator CG is preconditioned with (null: none).
+  Teuchos::RCP<operator_type> preconditioner_op() const {
+    return deflated.is_null() ? preconditioner->op() : Teuchos::rcp_implicit_cast<operator_type>(deflated);
+  }
+  /// Z: the rigid modes of the stiff bodies of `potential` on the owned dofs, projected by the
+  /// constraints (null when there is no stiff body).
+  void build_stiff_modes(const implicit::IncrementalPotential& potential);
 
   void build_near_nullspace();
   // Owned entries of a node field into a Tpetra vector on the owned dofs, and back.
@@ -53,6 +67,41 @@ void NewtonSystem::Impl::build_near_nullspace() {
     grid->owned_nodes.push_back(partition.geometry().node_index(partition.nodes()[i]));
   grid->owner = [&partition](const Int3& ijk) { return partition.grid_owner(ijk); };
   modes.grid = grid;
+}
+
+void NewtonSystem::Impl::build_stiff_modes(const implicit::IncrementalPotential& potential) {
+  const SolverSettings& settings = config.impl().settings;
+  const implicit::StiffBodies bodies =
+      implicit::find_stiff_bodies(potential, settings.stiff_cfl, settings.max_stiff_bodies, space.comm());
+  stiff_bodies = bodies.count;
+  if (bodies.count == 0) {
+    stiff_modes = Teuchos::null;
+    return;
+  }
+  const auto& partition = space.partition();
+  const std::size_t owned = space.impl().owned_count;
+  // Six modes per body: translations and rotations about its centroid (a body moves rigidly to
+  // first order, the stiff elastic energy barely resists these modes and a local smoother cannot
+  // reach them: they are the slow components CG is left with).
+  stiff_modes = Teuchos::rcp(new multivector_type(space.impl().owned_dof_map, 6 * bodies.count));
+  auto z = stiff_modes->getLocalViewHost(Tpetra::Access::OverwriteAll);
+  for (std::size_t i = 0; i < z.extent(0); ++i)
+    for (std::size_t a = 0; a < z.extent(1); ++a) z(i, a) = 0.0;
+  const auto& projection = potential.constraints().projection;
+  for (const auto& [node, body] : bodies.node_bodies) {
+    if (static_cast<std::size_t>(node) >= owned) continue;
+    const Vec3 r = partition.geometry().node_position(partition.nodes()[node]) - bodies.centroids[body];
+    const Mat3& P = projection[node];
+    // Translations e_d and rotations e_a × r, each through the node's constraint projection.
+    Mat3 rotations;
+    rotations << 0.0, r.z(), -r.y(), -r.z(), 0.0, r.x(), r.y(), -r.x(), 0.0;  // column a: e_a × r
+    const Mat3 rotation_columns = P * rotations;
+    for (int d = 0; d < 3; ++d)
+      for (int a = 0; a < 3; ++a) {
+        z(3 * node + d, 6 * body + a) = P(d, a);
+        z(3 * node + d, 6 * body + 3 + a) = rotation_columns(d, a);
+      }
+  }
 }
 
 void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
@@ -88,8 +137,6 @@ void NewtonSystem::build_pattern() {
   m.hessian->build_pattern();
   m.build_near_nullspace();
   m.pattern_version = m.space.version();
-  m.pattern_changed = true;
-  m.preconditioned = false;
 }
 
 double NewtonSystem::assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v,
@@ -97,19 +144,28 @@ double NewtonSystem::assemble(const implicit::IncrementalPotential& potential, c
   Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
   m.hessian->update(potential, v, project);
+  if (m.config.impl().settings.deflation == Deflation::stiff_bodies) m.build_stiff_modes(potential);
   return seconds_since(start);
 }
 
 double NewtonSystem::precondition() {
   Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  m.preconditioner->setup(*m.hessian, m.pattern_changed, m.modes);
-  m.pattern_changed = false;
-  m.preconditioned = true;
+  m.preconditioner->setup(*m.hessian, m.preconditioned_for != m.pattern_version, m.modes);
+  m.deflated = m.stiff_modes.is_null()
+                   ? Teuchos::null
+                   : Teuchos::rcp(new DeflatedPreconditioner(*m.hessian->op(), m.preconditioner->op(), m.stiff_modes));
+  m.preconditioned_for = m.pattern_version;
   return seconds_since(start);
 }
 
-bool NewtonSystem::preconditioned() const { return impl_->preconditioned; }
+bool NewtonSystem::preconditioned() const { return impl_->preconditioned_for == impl_->pattern_version; }
+
+void NewtonSystem::require_preconditioner(const char* caller) const {
+  if (!preconditioned())
+    throw std::logic_error(std::string("NewtonSystem::") + caller +
+                           ": the preconditioner was not set up for the current pattern (call precondition() first)");
+}
 
 std::vector<std::int64_t> NewtonSystem::preconditioner_levels() const { return impl_->preconditioner->level_rows(); }
 
@@ -142,22 +198,21 @@ double NewtonSystem::default_tolerance() const { return impl_->krylov.default_to
 
 LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) {
   Impl& m = *impl_;
-  const double setup_seconds = m.preconditioned ? 0.0 : precondition();
+  require_preconditioner("solve");
   const auto& s = m.space.impl();
   multivector_type b(s.owned_dof_map, 1), x(s.owned_dof_map, 1);
   m.to_owned(rhs, b);
-  LinearSolveReport report = m.krylov.solve(m.hessian->op(), m.preconditioner->op(), x, b, tolerance);
-  report.setup_seconds = setup_seconds;
+  LinearSolveReport report = m.krylov.solve(m.hessian->op(), m.preconditioner_op(), x, b, tolerance);
   m.from_owned(x, dv);
   return report;
 }
 
 void NewtonSystem::apply_preconditioner(const NodeVectorField& r, NodeVectorField& z) {
   Impl& m = *impl_;
-  if (!m.preconditioned) precondition();
+  require_preconditioner("apply_preconditioner");
   multivector_type R(m.space.impl().owned_dof_map, 1), Z(m.space.impl().owned_dof_map, 1);
   m.to_owned(r, R);
-  const auto op = m.preconditioner->op();
+  const auto op = m.preconditioner_op();
   if (op.is_null()) Z.assign(R);
   else op->apply(R, Z);
   m.from_owned(Z, z);
@@ -226,7 +281,22 @@ double NewtonSystem::time_apply(int repetitions) const {
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < repetitions; ++k) m.hessian->op()->apply(X, Y);
   m.space.comm().barrier();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repetitions;
+  return seconds_since(start) / repetitions;
+}
+
+double NewtonSystem::time_preconditioner(int repetitions) const {
+  const Impl& m = *impl_;
+  require_preconditioner("time_preconditioner");
+  const auto op = m.preconditioner_op();
+  if (op.is_null()) return 0.0;
+  multivector_type R(m.space.impl().owned_dof_map, 1), Z(m.space.impl().owned_dof_map, 1);
+  R.randomize();
+  op->apply(R, Z);  // warm-up
+  m.space.comm().barrier();
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < repetitions; ++k) op->apply(R, Z);
+  m.space.comm().barrier();
+  return seconds_since(start) / repetitions;
 }
 
 }  // namespace viscompm::linalg

@@ -11,6 +11,9 @@
 
 #include "preconditioner.hpp"
 
+#include "lean_cycle.hpp"
+#include "line_smoother.hpp"
+
 #include <Ifpack2_BlockRelaxation.hpp>
 #include <Ifpack2_Chebyshev.hpp>
 #include <iostream>
@@ -44,6 +47,12 @@ Teuchos::RCP<multivector_type> rigid_body_modes(const multivector_type& coordina
 namespace {
 using parts_type = Teuchos::Array<Teuchos::ArrayRCP<local_ordinal_type>>;
 
+// Grid index of node `id` (x fastest) on a grid of `dims` nodes.
+Int3 node_index(std::int64_t id, const Int3& dims) {
+  const std::int64_t nx = dims.x(), ny = dims.y();
+  return Int3(static_cast<int>(id % nx), static_cast<int>((id / nx) % ny), static_cast<int>(id / (nx * ny)));
+}
+
 // The runs of owned grid nodes along each axis as blocks of dofs (3 per node, consecutive).
 parts_type grid_line_parts(const SystemGrid& grid, int max_nodes) {
   parts_type parts;
@@ -76,7 +85,7 @@ class GridLines {
   /// on any rank count at first). Gauss-Seidel over the blocks needs none. Ifpack2 replaces its
   /// whole list on setParameters: every call passes the complete one.
   void set_damping(ifpack2_preconditioner_type& smoother, const crs_matrix_type& A, const SolverSettings& settings) {
-    if (list_.isType<std::string>("relaxation: type") && list_.get<std::string>("relaxation: type") != "Jacobi") return;
+    if (settings.line_combination != BlockCombination::jacobi) return;
     Teuchos::ParameterList one_sweep = list_;
     one_sweep.set("relaxation: damping factor", 1.0);
     one_sweep.set("relaxation: sweeps", 1);
@@ -181,11 +190,12 @@ class Ifpack2Preconditioner : public Preconditioner {
                          settings.ifpack2_type + "'");
       Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
       // 3×3 point-block relaxation: one block per node (a node's three dofs are consecutive).
-      if (settings.ifpack2_type == "BLOCK_RELAXATION" && !grid_lines && !params.isParameter("partitioner: local parts"))
+      const bool block_relaxation = settings.ifpack2_kind == Ifpack2Kind::block_relaxation;
+      if (block_relaxation && !grid_lines && !params.isParameter("partitioner: local parts"))
         params.set("partitioner: local parts", static_cast<local_ordinal_type>(A->getNodeNumRows() / 3));
       prec_->setParameters(grid_lines ? lines_.prepare(params, *grid_of(modes), settings.line_length) : params);
       prec_->initialize();
-    } else if (is_block_relaxation(settings.ifpack2_type)) {
+    } else if (settings.ifpack2_kind == Ifpack2Kind::block_relaxation) {
       // Ifpack2 13.2's block containers copy only the nonzero entries of a block when they are
       // computed again, over the factors of the last values: initialize() zeroes them first.
       prec_->initialize();
@@ -252,13 +262,16 @@ class MueLuPreconditioner : public Preconditioner {
     const Teuchos::RCP<crs_matrix_type> A = H.matrix();
     const SolverSettings& settings = config_.impl().settings;
     const bool grid_lines = settings.smoother_blocks == SmootherBlocks::grid_lines;
-    if (pattern_changed) geometric_levels_.clear();
-    if (!pattern_changed && !prec_.is_null() && settings.prolongation == Prolongation::algebraic && muelu_reuse()) {
+    if (pattern_changed) {
+      geometric_levels_.clear();
+      lines_.clear();
+    }
+    if (!pattern_changed && !prec_.is_null() && settings.prolongation == Prolongation::algebraic && settings.muelu_reuse) {
       try {
         const SilencedStdout quiet;
         MueLu::ReuseTpetraPreconditioner(A, *prec_);
         refresh_chebyshev_bounds();
-        if (grid_lines) set_fine_smoother_damping(*A);
+        finish_setup(H, *A, pattern_changed, modes);
         return;
       } catch (const std::exception&) {
         prec_ = Teuchos::null;  // built anew below
@@ -267,19 +280,24 @@ class MueLuPreconditioner : public Preconditioner {
     Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
     if (!params.isParameter("number of equations")) params.set("number of equations", 3);
     if (grid_lines) {
+      if (lines_.empty()) lines_.resize(1);
       Teuchos::ParameterList& smoother = params.sublist("level 0").sublist("smoother: params");
-      smoother = pattern_changed || lines_.list().numParams() == 0
-                     ? lines_.prepare(smoother, *grid_of(modes), settings.line_length)
-                     : lines_.list();
+      smoother = pattern_changed || lines_[0].list().numParams() == 0
+                     ? lines_[0].prepare(smoother, *grid_of(modes), settings.line_length)
+                     : lines_[0].list();
     }
+    // The lean cycle smooths the fine level itself: MueLu builds no level-0 smoother.
+    if (settings.cycle == Cycle::lean) params.sublist("level 0").set("smoother: pre or post", std::string("none"));
     {
       const SilencedStdout quiet;
       if (settings.prolongation == Prolongation::algebraic) setup_algebraic(A, params, modes);
       else setup_geometric(A, params, modes);
     }
-    if (grid_lines) set_fine_smoother_damping(*A);
+    finish_setup(H, *A, pattern_changed, modes);
   }
-  Teuchos::RCP<operator_type> op() const override { return prec_; }
+  Teuchos::RCP<operator_type> op() const override {
+    return lean_.is_null() ? Teuchos::rcp_implicit_cast<operator_type>(prec_) : Teuchos::rcp_implicit_cast<operator_type>(lean_);
+  }
   Teuchos::RCP<const crs_matrix_type> level_matrix(int level) const override {
     if (prec_.is_null() || level >= prec_->GetHierarchy()->GetNumLevels()) return Teuchos::null;
     const auto A = prec_->GetHierarchy()->GetLevel(level)->template Get<Teuchos::RCP<xpetra_matrix_type>>("A");
@@ -332,19 +350,39 @@ class MueLuPreconditioner : public Preconditioner {
                                                                        : parallel::Prolongation::quadratic_bspline;
     settings.max_levels = params.get<int>("max levels", 10);
     settings.coarsest_nodes = config_.impl().settings.coarsest_nodes;
-    // The prolongators depend on the grid only: built once per pattern.
-    if (geometric_levels_.empty()) {
+    // The prolongators depend on the grid only: built once per pattern, with the coarse grids'
+    // lines when the coarse levels smooth on them.
+    const SolverSettings& solver_settings = config_.impl().settings;
+    const int line_levels = solver_settings.smoother_blocks == SmootherBlocks::grid_lines ? solver_settings.line_levels : 0;
+    const bool new_levels = geometric_levels_.empty();
+    if (new_levels) {
       const auto levels = parallel::build_grid_hierarchy(communicator, modes.grid->dimensions, modes.grid->owned_nodes,
                                                          modes.grid->owner, settings);
       Teuchos::RCP<const map_type> fine = A->getRowMap();
-      for (const auto& level : levels) {
+      // Levels with smoothers: all but the coarsest, which is solved.
+      lines_.resize(std::max<std::size_t>(1, std::min<std::size_t>(line_levels, levels.size())));
+      for (std::size_t l = 0; l < levels.size(); ++l) {
+        const auto& level = levels[l];
         Teuchos::RCP<const map_type> coarse;
         geometric_levels_.push_back(MueLu::TpetraCrs_To_XpetraMatrix(make_prolongator(level, fine, coarse)));
         fine = coarse;
+        if (l + 1 < lines_.size()) {
+          SystemGrid grid;
+          grid.dimensions = level.dimensions;
+          for (std::size_t k = 0; k < level.owned_count; ++k) grid.owned_nodes.push_back(node_index(level.nodes[k], level.dimensions));
+          const Teuchos::ParameterList& fine_smoother = params.sublist("level 0").sublist("smoother: params");
+          lines_[l + 1].prepare(fine_smoother, grid, solver_settings.line_length);
+        }
       }
     }
-    for (std::size_t l = 0; l < geometric_levels_.size(); ++l)
-      params.sublist("level " + std::to_string(l + 1)).set("P", geometric_levels_[l]);
+    for (std::size_t l = 0; l < geometric_levels_.size(); ++l) {
+      Teuchos::ParameterList& level = params.sublist("level " + std::to_string(l + 1));
+      level.set("P", geometric_levels_[l]);
+      if (l + 1 < lines_.size()) {
+        level.set("smoother: type", params.sublist("level 0").get<std::string>("smoother: type"));
+        level.sublist("smoother: params") = lines_[l + 1].list();
+      }
+    }
     params.remove("reuse: type", false);  // what reuse can keep (the P) is kept above
     params.set("max levels", static_cast<int>(geometric_levels_.size()) + 1);
     params.set("coarse: max size", 1);
@@ -357,11 +395,6 @@ class MueLuPreconditioner : public Preconditioner {
     hierarchy->GetLevel(0)->Set("A", MueLu::TpetraCrs_To_XpetraMatrix(A));
     interpreter.SetupHierarchy(*hierarchy);
     prec_ = Teuchos::rcp(new muelu_operator_type(hierarchy));
-  }
-
-  bool muelu_reuse() const {
-    const auto& params = *config_.impl().preconditioner_parameters;
-    return params.isType<std::string>("reuse: type") && params.get<std::string>("reuse: type") != "none";
   }
 
   // The Ifpack2 smoothers of a level (pre and post, one object or two; MueLu's interpreter wraps
@@ -395,16 +428,37 @@ class MueLuPreconditioner : public Preconditioner {
       }
   }
 
-  // The fine level's block relaxation (pre- and post-smoother, one object or two) gets its damping.
+  // After MueLu's set-up: the grid-line smoothers' damping, and the lean cycle around the hierarchy.
+  void finish_setup(const HessianOperator& H, const crs_matrix_type& A, bool pattern_changed, const NearNullspace& modes) {
+    const SolverSettings& settings = config_.impl().settings;
+    if (settings.smoother_blocks == SmootherBlocks::grid_lines) set_fine_smoother_damping(A);
+    if (settings.cycle != Cycle::lean) return;
+    if (pattern_changed || !lean_lines_)
+      lean_lines_ = std::make_shared<LineSmoother>(grid::node_lines(grid_of(modes)->owned_nodes, settings.line_length));
+    lean_lines_->compute(A, *H.op(), settings.line_damping);
+    lean_ = Teuchos::rcp(new LeanCycle(H.op(), lean_lines_, prec_->GetHierarchy()));
+  }
+
+  // The block relaxations on grid lines (pre- and post-smoother, one object or two) get their
+  // damping: the fine level's (unless the lean cycle smooths it), and the coarse levels' of a
+  // geometric hierarchy with Line levels.
   void set_fine_smoother_damping(const crs_matrix_type& A) {
-    for (const auto& smoother : level_smoothers(0))
-      lines_.set_damping(*smoother->getPreconditioner(), A, config_.impl().settings);
+    if (config_.impl().settings.cycle != Cycle::lean)
+      for (const auto& smoother : level_smoothers(0))
+        lines_[0].set_damping(*smoother->getPreconditioner(), A, config_.impl().settings);
+    for (std::size_t l = 1; l < lines_.size() && static_cast<int>(l) < prec_->GetHierarchy()->GetNumLevels(); ++l) {
+      const auto level_matrix = this->level_matrix(static_cast<int>(l));
+      for (const auto& smoother : level_smoothers(static_cast<int>(l)))
+        lines_[l].set_damping(*smoother->getPreconditioner(), *level_matrix, config_.impl().settings);
+    }
   }
 
   SolverConfiguration config_;
   Teuchos::RCP<muelu_operator_type> prec_;
   std::vector<Teuchos::RCP<xpetra_matrix_type>> geometric_levels_;  // P of levels 1, 2, ... (this pattern)
-  GridLines lines_;
+  std::vector<GridLines> lines_;  // per level that smooths on grid lines, finest first
+  std::shared_ptr<LineSmoother> lean_lines_;  // Cycle = lean: the fine level's smoother
+  Teuchos::RCP<LeanCycle> lean_;              // Cycle = lean: the preconditioner
 };
 }  // namespace
 

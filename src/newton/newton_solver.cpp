@@ -93,48 +93,50 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
   rules_.begin_solve(potential.dt(), system_.pattern_version(), system_.matrix_free());
   lbfgs_.clear();
   NodeVectorField g, dv;
-  // At most max_iterations directions; each pass ends in `break` or one more direction.
-  for (;;) {
-    // Residual: g = ∇E(v), complete on the owned nodes.
-    {
-      Teuchos::TimeMonitor t(gradient_timer());
-      const auto start = std::chrono::steady_clock::now();
-      const bool feasible = potential.gradient(v, g);
-      report.gradient_seconds += seconds_since(start);
-      if (comm_.any(!feasible)) {
-        report.failure = "infeasible state";
-        break;
-      }
-    }
-    const double residual = velocity_residual(potential, g, comm_);
-    if (!report.residual_history.empty()) rules_.residual(report.residual_history.back(), residual);
-    report.residual = residual;
-    report.residual_history.push_back(residual);
-
-    // Convergence test.
-    if (!std::isfinite(residual)) {
-      report.failure = "residual is not finite";
-      break;
-    }
-    if (residual <= report.tolerance) {
-      report.converged = true;
-      break;
-    }
-    if (report.iterations == settings_.max_iterations) {
-      report.failure = "no convergence in " + std::to_string(settings_.max_iterations) + " iterations";
-      break;
-    }
-    if (stop_requested(step)) break;
+  // A counted loop: `Max iterations` directions at most, each after the residual and its tests;
+  // the residual after the last direction is tested once more.
+  const auto finish = [&]() -> NewtonReport {
+    if (!report.converged) forget();
+    return report;
+  };
+  for (int direction = 0; direction < settings_.max_iterations; ++direction) {
+    if (residual_settles(step, g) || stop_requested(step)) return finish();
     ++report.iterations;
-
     // Direction, then the line search along it (both inside: a failed line search may call for a
     // fresh or projected Hessian).
     const bool moved = settings_.method == Method::lbfgs ? lbfgs_direction_and_line_search(step, g, dv)
                                                          : newton_direction_and_line_search(step, g, dv);
-    if (!moved) break;
+    if (!moved) return finish();
   }
-  if (!report.converged) forget();
-  return report;
+  if (!residual_settles(step, g) && report.failure.empty())
+    report.failure = "no convergence in " + std::to_string(settings_.max_iterations) + " iterations";
+  return finish();
+}
+
+bool NewtonSolver::residual_settles(Step& step, NodeVectorField& g) {
+  NewtonReport& report = step.report;
+  // Residual: g = ∇E(v), complete on the owned nodes.
+  {
+    Teuchos::TimeMonitor t(gradient_timer());
+    const auto start = std::chrono::steady_clock::now();
+    const bool feasible = step.potential.gradient(step.v, g);
+    report.gradient_seconds += seconds_since(start);
+    if (comm_.any(!feasible)) {
+      report.failure = "infeasible state";
+      return true;
+    }
+  }
+  const double residual = velocity_residual(step.potential, g, comm_);
+  if (!report.residual_history.empty()) rules_.residual(report.residual_history.back(), residual);
+  report.residual = residual;
+  report.residual_history.push_back(residual);
+  // Convergence test.
+  if (!std::isfinite(residual)) {
+    report.failure = "residual is not finite";
+    return true;
+  }
+  report.converged = residual <= report.tolerance;
+  return report.converged;
 }
 
 bool NewtonSolver::stop_requested(Step& step) const {

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <fstream>
+#include <limits>
+#include <string>
 
 namespace viscompm::parallel {
 
@@ -110,6 +112,27 @@ double memory_per_rank(const Communicator& comm) {
   MPI_Comm_size(node, &ranks_here);
   MPI_Comm_free(&node);
   return machine_memory() / ranks_here;
+}
+
+double peak_memory() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  double kib = 0.0;
+  while (status >> key) {
+    if (key == "VmHWM:") {
+      status >> kib;
+      return 1024.0 * kib;
+    }
+    status.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  return 0.0;
+}
+
+bool reset_peak_memory() {
+  std::ofstream clear("/proc/self/clear_refs");
+  clear << "5";  // resets VmHWM to the current resident size
+  clear.flush();
+  return static_cast<bool>(clear);
 }
 
 }  // namespace viscompm::parallel

@@ -30,8 +30,11 @@ const ParameterTable<StudySettings>& StudySettings::table() {
                    "scene's own)")
         .real_list(&S::time_steps, "Time steps", {10.0}, Range::positive(), "systems: Δt of the step, in Time step unit")
         .choice(&S::time_step_unit, "Time step unit", TimeStepUnit::elastic_cfl,
-                {{"elastic CFL", TimeStepUnit::elastic_cfl}, {"seconds", TimeStepUnit::seconds}},
-                "elastic CFL: multiples of Δx/c with c = √((λ+2μ)/ρ) of the stiffest material")
+                {{"elastic CFL", TimeStepUnit::elastic_cfl}, {"seconds", TimeStepUnit::seconds},
+                 {"particle CFL", TimeStepUnit::particle_cfl}},
+                "elastic CFL: multiples of Δx/c with c = √((λ+2μ)/ρ) of the stiffest material; particle CFL: "
+                "multiples of the step a run takes there (CFL·Δx over the fastest particle, collider or inflow, "
+                "at most Max time step)")
         .real(&S::time, "Time", 0.0, Range::non_negative(),
               "systems: advance the scene to this time before taking the system [s]")
         .choice(&S::right_hand_side, "Right-hand side", RightHandSide::newton,
@@ -44,7 +47,7 @@ const ParameterTable<StudySettings>& StudySettings::table() {
         .integer(&S::repetitions, "Repetitions", 1, Range::closed(1, 100), "systems: solves per pair; the fastest is kept")
         .integer(&S::frames, "Frames", 2, Range::at_least(1), "steps: frames of the scene per configuration")
         .string_list(&S::scene_overrides, "Scene overrides", {},
-                     "steps: \"Path/To/Parameter=value\" applied to the scene, as --set does")
+                     "\"Path/To/Parameter=value\" applied to the scene, as --set does")
         .string(&S::output_directory, "Output directory", "output/study", {}, "where the CSV files and plots go")
         .boolean(&S::plot, "Plot", true, "write study.png or steps.png (needs python3-matplotlib)");
     return table;
@@ -68,6 +71,43 @@ struct ConfigurationSettings {
   }
 };
 
+// A sublist of "Scenes" (systems mode); what it leaves out comes from the study's top level.
+struct SceneEntrySettings {
+  std::string scene;
+  double time = 0.0;
+  StringList overrides;
+  double smallest_cell = 0.0;
+  static const ParameterTable<SceneEntrySettings>& table() {
+    static const ParameterTable<SceneEntrySettings> t = [] {
+      ParameterTable<SceneEntrySettings> table;
+      using E = SceneEntrySettings;
+      table.string(&E::scene, "Scene", "", {}, "scene file, relative to the study file")
+          .real(&E::time, "Time", -1.0, Range::at_least(-1.0), "advance the scene to this time first [s] (-1: the study's Time)")
+          .string_list(&E::overrides, "Scene overrides", {},
+                       "\"Path/To/Parameter=value\" applied to the scene after the study's own Scene overrides")
+          .real(&E::smallest_cell, "Smallest cell size", 0.0, Range::non_negative(),
+                "leave out the study's Cell sizes below this one [m] (for a scene too large at those sizes)");
+      return table;
+    }();
+    return t;
+  }
+};
+
+// An Array(string) of overrides cannot hold braces (Teuchos rejects them) and is split at every
+// comma: a vector value is written in parentheses ("Bodies/a/Center=(1, 2, 3)"), its pieces are
+// joined again until the parentheses balance, and the parentheses become the braces --set takes.
+StringList rejoin_vectors(const StringList& pieces) {
+  StringList joined;
+  int depth = 0;
+  for (const auto& piece : pieces) {
+    if (depth > 0) joined.back() += ", " + piece;
+    else joined.push_back(piece);
+    for (char c : piece) depth += c == '(' ? 1 : c == ')' ? -1 : 0;
+  }
+  for (auto& o : joined)
+    for (char& c : o) c = c == '(' ? '{' : c == ')' ? '}' : c;
+  return joined;
+}
 
 std::string relative_to(const std::string& file, const std::string& path) {
   const std::filesystem::path p(path);
@@ -99,10 +139,13 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The scene of a systems study at cell size h: the cell size as an override, so that what
+// A scene of a systems study at cell size h: its overrides, then the cell size, so that what
 // derives from it (meshes' voxels, disc nozzles, the size checks) follows.
-scene::SceneConfig scene_at(const StudySettings& settings, double h) {
-  return scene::read_scene(settings.scene, {{"Grid/Cell size", exact(h)}});
+scene::SceneConfig scene_at(const StudySettings::SceneEntry& entry, double h) {
+  std::vector<scene::Override> overrides;
+  for (const auto& o : entry.overrides) overrides.push_back(scene::Override::parse(o));
+  overrides.push_back({"Grid/Cell size", exact(h)});
+  return scene::read_scene(entry.scene, overrides);
 }
 
 // The scene of a steps configuration: the study's scene overrides, the cell size h (0: as they
@@ -142,6 +185,9 @@ struct Row {
   double resolution = 0.0;
   std::int64_t dofs = 0, nonzeros = 0;
   linalg::LinearSolveReport report;
+  double apply_seconds = 0.0;                 // one application of H
+  double preconditioner_apply_seconds = 0.0;  // one application of the preconditioner (a V-cycle)
+  double peak_memory = 0.0;                   // bytes, the largest rank's, during this configuration
 };
 
 class Writer {
@@ -152,7 +198,8 @@ class Writer {
     open_csv(operators_, directory, "operators.csv", study_file, comm);
     if (!root_) return;
     study_ << "problem,resolution,dofs,nonzeros,ranks,preconditioner,setup_seconds,solve_seconds,iterations,"
-              "relative_residual,converged,operator_seconds\n";
+              "relative_residual,converged,operator_seconds,apply_seconds,preconditioner_apply_seconds,"
+              "peak_memory_mib\n";
     operators_ << "problem,resolution,dofs,ranks,preconditioner,operator,assembly_seconds,apply_seconds\n";
   }
   void row(const Row& r) {
@@ -161,13 +208,15 @@ class Writer {
     study_ << '"' << r.problem << "\"," << r.resolution << ',' << r.dofs << ',' << r.nonzeros << ',' << ranks_ << ",\""
            << r.report.preconditioner << "\"," << r.report.setup_seconds << ',' << r.report.solve_seconds << ','
            << r.report.iterations << ',' << r.report.relative_residual << ',' << (r.report.converged ? 1 : 0) << ','
-           << r.report.operator_seconds << '\n';
+           << r.report.operator_seconds << ',' << r.apply_seconds << ',' << r.preconditioner_apply_seconds << ','
+           << r.peak_memory / (1024.0 * 1024.0) << '\n';
     study_.flush();
   }
-  void operator_row(const Row& r, const std::string& form, double apply) {
+  void operator_row(const Row& r, const std::string& form) {
     if (!root_) return;
     operators_ << '"' << r.problem << "\"," << r.resolution << ',' << r.dofs << ',' << ranks_ << ",\""
-               << r.report.preconditioner << "\"," << form << ',' << r.report.operator_seconds << ',' << apply << '\n';
+               << r.report.preconditioner << "\"," << form << ',' << r.report.operator_seconds << ','
+               << r.apply_seconds << '\n';
     operators_.flush();
   }
   int rows() const { return rows_; }
@@ -184,14 +233,17 @@ void log_row(std::ostream& log, const Row& row) {
   log << std::setw(28) << std::left << row.problem << " dx=" << row.resolution << " dofs=" << row.dofs << "  "
       << std::setw(22) << r.preconditioner << std::right << " it=" << std::setw(5) << r.iterations
       << " operator=" << std::setprecision(3) << r.operator_seconds << "s setup=" << r.setup_seconds
-      << "s solve=" << r.solve_seconds << "s" << (r.converged ? "" : "  NOT CONVERGED") << std::setprecision(6)
-      << std::endl;
+      << "s solve=" << r.solve_seconds << "s apply=" << row.apply_seconds * 1e3 << "ms preconditioner="
+      << row.preconditioner_apply_seconds * 1e3 << "ms peak=" << std::setprecision(4)
+      << row.peak_memory / (1024.0 * 1024.0) << "MiB" << (r.converged ? "" : "  NOT CONVERGED")
+      << std::setprecision(6) << std::endl;
   if (!r.failure.empty()) log << "  " << r.failure.substr(0, r.failure.find('\n')) << std::endl;
 }
 
 // What a systems study reads, all of it before any output file is opened.
 struct SystemsInputs {
-  std::vector<scene::SceneConfig> scenes;  ///< one per cell size
+  /// One per scene entry and cell size, with its entry.
+  std::vector<std::pair<const StudySettings::SceneEntry*, scene::SceneConfig>> scenes;
   std::vector<linalg::SolverConfiguration> configs;
   std::vector<std::unique_ptr<linalg::MatrixMarketProblem>> problems;
 };
@@ -199,10 +251,10 @@ struct SystemsInputs {
 SystemsInputs read_systems_inputs(const StudySettings& settings, const parallel::Communicator& comm) {
   SystemsInputs inputs;
   for (const auto& s : settings.solvers) inputs.configs.push_back(linalg::SolverConfiguration::read(s));
-  if (!settings.scene.empty())
-    for (double h : settings.cell_sizes) {
-      inputs.scenes.push_back(scene_at(settings, h));
-      simulation::check_memory(inputs.scenes.back(), comm);
+  for (const auto& entry : settings.scenes)
+    for (double h : entry.cell_sizes) {
+      inputs.scenes.emplace_back(&entry, scene_at(entry, h));
+      simulation::check_memory(inputs.scenes.back().second, comm);
     }
   for (const auto& file : settings.matrix_market_files)
     inputs.problems.push_back(std::make_unique<linalg::MatrixMarketProblem>(file, comm));
@@ -216,9 +268,10 @@ void solve_scene_system(const StudySettings& settings, const linalg::SolverConfi
                         simulation::TimeIntegrator& integrator, const simulation::StepObjective& objective,
                         const NodeVectorField& rhs, Row& row, Writer& writer, const parallel::Communicator& comm,
                         std::ostream& log) {
+  parallel::reset_peak_memory();
   linalg::NewtonSystem system(integrator.node_space(), config);
   row.dofs = system.global_rows();
-  double apply = 0.0;
+  row.apply_seconds = row.preconditioner_apply_seconds = 0.0;
   linalg::LinearSolveReport best;
   const auto total = [](const linalg::LinearSolveReport& r) { return r.operator_seconds + r.setup_seconds + r.solve_seconds; };
   try {
@@ -231,7 +284,8 @@ void solve_scene_system(const StudySettings& settings, const linalg::SolverConfi
       report.setup_seconds = setup_seconds;
       if (k == 0 || total(report) < total(best)) best = report;
     }
-    apply = system.time_apply(5);
+    row.apply_seconds = system.time_apply(5);
+    row.preconditioner_apply_seconds = system.time_preconditioner(5);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -241,8 +295,9 @@ void solve_scene_system(const StudySettings& settings, const linalg::SolverConfi
   }
   if (!system.matrix_free()) row.nonzeros = system.global_nonzeros();
   row.report = best;
+  row.peak_memory = comm.max(parallel::peak_memory());
   writer.row(row);
-  writer.operator_row(row, system.matrix_free() ? "matrix-free" : "assembled", apply);
+  writer.operator_row(row, system.matrix_free() ? "matrix-free" : "assembled");
   if (comm.is_root()) log_row(log, row);
 }
 
@@ -264,17 +319,23 @@ bool right_hand_side(const StudySettings& settings, simulation::TimeIntegrator& 
 // The first Newton system of a scene at each cell size and Δt, under every configuration.
 void study_scene_systems(const StudySettings& settings, const SystemsInputs& inputs, const parallel::Communicator& comm,
                          Writer& writer, std::ostream& log) {
-  for (const scene::SceneConfig& scene : inputs.scenes) {
+  for (const auto& [entry, scene] : inputs.scenes) {
     // Advance with the scene's own solver, then take the step's Newton system at several Δt.
     simulation::Simulation sim(scene, scene::solver_configuration(scene), comm);
-    if (settings.time > 0.0) {
+    if (entry->time > 0.0) {
       simulation::RunSummary summary;
-      sim.advance_to(settings.time, summary);
+      sim.advance_to(entry->time, summary);
     }
     double wave_speed = 0.0;
     for (const auto& m : sim.materials()) wave_speed = std::max(wave_speed, m->wave_speed());
-    const bool cfl = settings.time_step_unit == TimeStepUnit::elastic_cfl;
-    auto seconds = [&](double step) { return cfl ? step * sim.grid().dx / wave_speed : step; };
+    const double run_step = sim.suggested_time_step();
+    const TimeStepUnit unit = settings.time_step_unit;
+    auto seconds = [&](double step) {
+      return unit == TimeStepUnit::elastic_cfl ? step * sim.grid().dx / wave_speed
+             : unit == TimeStepUnit::particle_cfl ? step * run_step
+                                                  : step;
+    };
+    const char* unit_name = unit == TimeStepUnit::elastic_cfl ? "xCFL" : unit == TimeStepUnit::particle_cfl ? "xrun" : "s";
     double largest_step = 0.0;
     for (double step : settings.time_steps) largest_step = std::max(largest_step, seconds(step));
     auto& integrator = sim.integrator();
@@ -282,7 +343,8 @@ void study_scene_systems(const StudySettings& settings, const SystemsInputs& inp
     for (double step : settings.time_steps) {
       const auto objective = integrator.build_objective(sim.particles(), sim.time(), seconds(step));
       Row row;
-      row.problem = scene.name + " t=" + number(sim.time()) + " dt=" + number(step) + (cfl ? "xCFL" : "s");
+      row.problem = (entry->label.empty() ? scene.name : entry->label) + " t=" + number(sim.time()) + " dt=" + number(seconds(step)) + "s (" +
+                    number(step) + unit_name + ")";
       row.resolution = scene.grid.cell_size;
       row.nonzeros = -1;
       NodeVectorField rhs;
@@ -313,6 +375,7 @@ void study_matrix_market(const SystemsInputs& inputs, const StudySettings& setti
       row.dofs = problem.rows();
       row.nonzeros = problem.nonzeros();
       linalg::MatrixMarketSolve solved;
+      parallel::reset_peak_memory();
       try {
         solved = problem.solve(config);
       } catch (const InputError&) {
@@ -322,8 +385,11 @@ void study_matrix_market(const SystemsInputs& inputs, const StudySettings& setti
         if (comm.is_root()) log << "  " << config.label() << " failed: " << e.what() << "\n";
       }
       row.report = solved.report;
+      row.apply_seconds = comm.max(solved.apply_seconds);
+      row.preconditioner_apply_seconds = comm.max(solved.preconditioner_apply_seconds);
+      row.peak_memory = comm.max(parallel::peak_memory());
       writer.row(row);
-      writer.operator_row(row, "assembled", solved.apply_seconds);
+      writer.operator_row(row, "assembled");
       if (comm.is_root()) log_row(log, row);
     }
   }
@@ -420,6 +486,48 @@ void read_configurations(const Teuchos::ParameterList& list, const std::string& 
 }
 }  // namespace
 
+namespace {
+// The scenes of the systems mode: the "Scenes" sublist (a sublist each, what it leaves out taken
+// from the top level), else the top-level Scene; each with at least one cell size.
+void read_scene_entries(const Teuchos::ParameterList& list, const std::string& file, StudySettings& settings) {
+  const auto checked_overrides = [&](const StringList& overrides, const std::string& parameter) {
+    for (const auto& o : overrides) {
+      try {
+        (void)scene::Override::parse(o);
+      } catch (const InputError&) {
+        throw parameter_error(file, parameter, "'" + o + "' is not Path/To/Parameter=value");
+      }
+    }
+    return overrides;
+  };
+  const StringList top_overrides = checked_overrides(settings.scene_overrides, "Scene overrides");
+  if (list.isSublist("Scenes")) {
+    if (!settings.scene.empty())
+      throw parameter_error(file, "Scene", "give either Scene or a Scenes sublist, not both");
+    const auto& scenes = list.sublist("Scenes");
+    for (auto it = scenes.begin(); it != scenes.end(); ++it) {
+      const std::string& name = scenes.name(it);
+      const std::string path = "Scenes/" + name;
+      if (!scenes.isSublist(name)) throw parameter_error(file, path, "expected a sublist");
+      const auto e = SceneEntrySettings::table().parse(
+          params::read_parameters(scenes.sublist(name), SceneEntrySettings::table().specs(), file, path));
+      if (e.scene.empty()) throw parameter_error(file, path + "/Scene", "give a scene file");
+      StudySettings::SceneEntry entry{name, study_input(file, path + "/Scene", e.scene), e.time < 0.0 ? settings.time : e.time,
+                                      top_overrides, {}};
+      for (const auto& o : checked_overrides(rejoin_vectors(e.overrides), path + "/Scene overrides")) entry.overrides.push_back(o);
+      if (settings.cell_sizes.empty()) throw parameter_error(file, "Cell sizes", "give at least one resolution");
+      for (double h : settings.cell_sizes)
+        if (h >= e.smallest_cell) entry.cell_sizes.push_back(h);
+      settings.scenes.push_back(entry);
+    }
+    if (settings.scenes.empty()) throw parameter_error(file, "Scenes", "give at least one scene");
+  } else if (!settings.scene.empty()) {
+    if (settings.cell_sizes.empty()) throw parameter_error(file, "Cell sizes", "give at least one resolution");
+    settings.scenes.push_back({"", settings.scene, settings.time, top_overrides, settings.cell_sizes});
+  }
+}
+}  // namespace
+
 StudySettings read_study(const std::string& file, const std::vector<scene::Override>& overrides) {
   auto list = params::read_xml_file(file);
   const auto& specs = StudySettings::table().specs();
@@ -433,23 +541,24 @@ StudySettings read_study(const std::string& file, const std::vector<scene::Overr
     }
   }
   StudySettings settings =
-      StudySettings::table().parse(params::read_parameters(*list, specs, file, "", {"Configurations"}));
-  if (settings.scene.empty() && settings.matrix_market_files.empty())
-    throw parameter_error(file, "Scene", "a study needs a scene or Matrix Market files");
+      StudySettings::table().parse(params::read_parameters(*list, specs, file, "", {"Configurations", "Scenes"}));
+  settings.scene_overrides = rejoin_vectors(settings.scene_overrides);
+  if (settings.scene.empty() && settings.matrix_market_files.empty() && !list->isSublist("Scenes"))
+    throw parameter_error(file, "Scene", "a study needs a scene (or Scenes) or Matrix Market files");
   // The files the study names, resolved against it: a missing one names the study's parameter.
   if (!settings.scene.empty()) settings.scene = study_input(file, "Scene", settings.scene);
   for (auto& s : settings.solvers) s = study_input(file, "Solvers", s);
   for (auto& m : settings.matrix_market_files) m = study_input(file, "Matrix Market files", m);
   if (settings.mode == StudyMode::steps) {
     if (settings.scene.empty()) throw parameter_error(file, "Scene", "the steps mode needs a scene");
+    if (list->isSublist("Scenes")) throw parameter_error(file, "Scenes", "the steps mode takes one Scene");
     read_configurations(*list, file, settings);
     return settings;
   }
-  if (!settings.scene.empty() && settings.cell_sizes.empty())
-    throw parameter_error(file, "Cell sizes", "give at least one resolution");
+  read_scene_entries(*list, file, settings);
   if (settings.solvers.empty()) throw parameter_error(file, "Solvers", "give at least one solver file");
-  for (double h : settings.cell_sizes)
-    if (!settings.scene.empty()) (void)scene_at(settings, h);
+  for (const auto& entry : settings.scenes)
+    for (double h : entry.cell_sizes) (void)scene_at(entry, h);
   for (const auto& s : settings.solvers) (void)linalg::SolverConfiguration::read(s);
   return settings;
 }

@@ -38,6 +38,7 @@ linalg::LinearSolveReport solve_sponge_system(const linalg::SolverConfiguration&
   EXPECT_TRUE(integrator.first_right_hand_side(*objective, g));
   auto& system = integrator.newton_system();
   system.assemble(*objective->potential, objective->initial_guess, true);
+  system.precondition();
   NodeVectorField dv;
   return system.solve(g, dv);
 }
@@ -204,5 +205,34 @@ TEST(SolverConfigurations, AOneRankSolverFileIsBadInputOnMoreRanks) {
       EXPECT_NE(std::string(e.what()).find("muelu_brick_cg.xml: parameter 'Ranks'"), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("one rank"), std::string::npos) << e.what();
     }
+  }
+}
+
+TEST(SolverConfigurations, EverySpellingOfBlockRelaxationGivesTheSameSmoother) {
+  // Ifpack2 accepts its block relaxation as BLOCK_RELAXATION, BLOCK RELAXATION and BLOCKRELAXATION;
+  // the reader parses the word once, so every spelling gets the one-block-per-node partition and
+  // the same solve (a spelling compared as a string further down would get Ifpack2's default
+  // partition: one block for the whole rank, a direct solve).
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  auto file = [](const std::string& type) {
+    return "<ParameterList name=\"x\"><Parameter name=\"Preconditioner\" type=\"string\" value=\"Ifpack2\"/>"
+           "<Parameter name=\"Ifpack2 type\" type=\"string\" value=\"" + type + "\"/>"
+           "<ParameterList name=\"Krylov parameters\"><Parameter name=\"Convergence Tolerance\" type=\"double\" "
+           "value=\"1e-8\"/><Parameter name=\"Maximum Iterations\" type=\"int\" value=\"2000\"/></ParameterList>"
+           "<ParameterList name=\"Preconditioner parameters\"><Parameter name=\"relaxation: type\" type=\"string\" "
+           "value=\"Jacobi\"/></ParameterList></ParameterList>";
+  };
+  std::vector<linalg::LinearSolveReport> reports;
+  for (const char* spelling : {"BLOCK_RELAXATION", "BLOCK RELAXATION", "BLOCKRELAXATION"}) {
+    const auto config = linalg::SolverConfiguration::from_xml(file(spelling), spelling);
+    EXPECT_EQ(config.label(), "Ifpack2 BLOCK_RELAXATION Jacobi") << spelling;
+    reports.push_back(solve_sponge_system(config, world));
+    EXPECT_TRUE(reports.back().converged) << spelling;
+  }
+  // Node blocks need more than a handful of iterations on this system; one rank-sized block would not.
+  EXPECT_GT(reports[0].iterations, 10);
+  for (const auto& r : reports) {
+    EXPECT_EQ(r.iterations, reports[0].iterations);
+    EXPECT_DOUBLE_EQ(r.relative_residual, reports[0].relative_residual);
   }
 }

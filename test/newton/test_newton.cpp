@@ -263,3 +263,38 @@ TEST(Newton, AHierarchyReusedAcrossIterationsAndStepsReachesTheStateOfAFreshOne)
     EXPECT_LT(reused.setups, fresh.setups) << update;
   }
 }
+
+TEST_F(NewtonOnASpinningBlock, AnIterationBoundBelowOneEndsTheSolveWithoutADirection) {
+  // Max iterations is read as at least 1, but a caller in code may set anything: the loop is
+  // counted, so 0 or −1 directions end the solve after testing the initial residual once.
+  for (int bound : {0, -1}) {
+    newton::NewtonSettings settings = scene.newton;
+    settings.max_iterations = bound;
+    newton::NewtonSolver solver(settings, sim.integrator().newton_system(), comm);
+    NodeVectorField v_try = v;
+    const auto report = solver.solve(*objective->potential, v_try);
+    EXPECT_EQ(report.iterations, 0) << bound;
+    EXPECT_FALSE(report.converged) << bound;
+    EXPECT_EQ(report.residual_history.size(), 1u) << bound;
+    EXPECT_NE(report.failure.find("no convergence in " + std::to_string(bound) + " iterations"), std::string::npos)
+        << report.failure;
+  }
+}
+
+TEST_F(NewtonOnASpinningBlock, EveryPreconditionerSetUpGoesThroughTheSeamAndIsCounted) {
+  // The system never sets its preconditioner up by itself: a solve before any set-up is a
+  // contract violation, and in a Newton solve the set-ups the seam sees are the ones reported.
+  auto& system = sim.integrator().newton_system();
+  NodeVectorField rhs(v.size(), Vec3::UnitX()), dv;
+  system.assemble(*objective->potential, v, true);
+  EXPECT_THROW(system.solve(rhs, dv), std::logic_error);
+  EXPECT_THROW(system.apply_preconditioner(rhs, dv), std::logic_error);
+  FailingSystem counting(system);
+  counting.failing = false;
+  newton::NewtonSolver solver(scene.newton, counting, comm);
+  const auto report = solver.solve(*objective->potential, v);
+  ASSERT_TRUE(report.converged) << report.failure;
+  EXPECT_GE(counting.setups, 1);
+  EXPECT_EQ(counting.setups, report.preconditioner_setups);
+  EXPECT_EQ(counting.assemblies, report.assemblies);
+}

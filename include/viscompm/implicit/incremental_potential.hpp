@@ -35,6 +35,9 @@ class IncrementalPotential {
 
   double dt() const { return dt_; }
   const grid::GridLayout& layout() const { return layout_; }
+  /// The particles (own, then ghosts, as binned in layout()) and their materials.
+  const particles::ParticleSet& particles() const { return particles_; }
+  const materials::MaterialList& materials() const { return materials_; }
   const NodeScalarField& mass() const { return mass_; }
   const boundary::NodeConstraints& constraints() const { return constraints_; }
 

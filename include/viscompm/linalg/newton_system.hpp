@@ -33,18 +33,19 @@ class NewtonSystem {
   /// `project`. Returns the seconds it took.
   double assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project);
   /// Sets up the preconditioner for the current H (or refreshes it, reusing what the solver file's
-  /// reuse options allow). Returns the seconds it took.
+  /// reuse options allow). Returns the seconds it took. The caller decides when (newton::ReuseRules
+  /// in a run): solve and apply_preconditioner never set it up themselves.
   double precondition();
   /// The NodeSpace version the pattern was built for.
   std::uint64_t pattern_version() const;
   /// True once precondition() has run for the current sparsity pattern.
   bool preconditioned() const;
   /// Solves H dv = rhs from dv = 0 to the relative residual `tolerance` (≤ 0: the solver file's)
-  /// with the last preconditioner (set up first if there is none); rhs on the owned nodes, dv
-  /// returned on all local nodes.
+  /// with the last preconditioner, which must have been set up for the current pattern
+  /// (std::logic_error otherwise); rhs on the owned nodes, dv returned on all local nodes.
   LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance = 0.0);
-  /// z = P⁻¹ r, one application of the current preconditioner (set up first if there is none;
-  /// z = r without one); r on the owned nodes, z returned on all local nodes. Collective.
+  /// z = P⁻¹ r, one application of the current preconditioner (set up as for solve; z = r
+  /// without one); r on the owned nodes, z returned on all local nodes. Collective.
   void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z);
   /// False for a configuration without a preconditioner.
   bool has_preconditioner() const;
@@ -71,11 +72,15 @@ class NewtonSystem {
   void write_matrix_market(const std::string& prefix, const NodeVectorField& rhs) const;
   /// Seconds per application of H (mean of `repetitions`), for benchmarks (collective).
   double time_apply(int repetitions) const;
+  /// Seconds per application of the preconditioner (mean of `repetitions`; 0 without one): one
+  /// V-cycle of a multigrid (collective; after precondition()).
+  double time_preconditioner(int repetitions) const;
   const SolverConfiguration& configuration() const;
 
   struct Impl;
 
  private:
+  void require_preconditioner(const char* caller) const;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -85,6 +85,9 @@ class NewtonSolver {
     bool fresh;    // assemble H now (else the kept one)
     bool project;  // the PSD-projected H
   };
+  /// Evaluates the residual g = ∇E(v) and records it; true when the solve ends here (converged,
+  /// or an infeasible or non-finite state: report.failure says which).
+  bool residual_settles(Step& step, NodeVectorField& g);
   bool stop_requested(Step& step) const;
   bool newton_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv);
   bool try_newton_direction(Step& step, const NodeVectorField& rhs, double tolerance, const Attempt& attempt,

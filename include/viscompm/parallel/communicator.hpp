@@ -50,6 +50,12 @@ class Communicator {
 double machine_memory();
 /// The memory each rank of `comm` may use: the machine's, shared among the ranks on it (collective).
 double memory_per_rank(const Communicator& comm);
+/// This process's peak resident memory in bytes since it started or since the last
+/// reset_peak_memory() (Linux: VmHWM of /proc/self/status; 0 where unknown).
+double peak_memory();
+/// Starts a new peak-memory measurement for this process (Linux: /proc/self/clear_refs); false
+/// where that is not possible, and peak_memory() then counts from the start of the process.
+bool reset_peak_memory();
 
 template <class T>
 std::vector<std::vector<T>> Communicator::exchange(const std::vector<std::vector<T>>& outgoing) const {

@@ -53,6 +53,8 @@ class Simulation {
   }
 
   double time() const { return state_.time; }
+  /// The Δt the next step would try (the particle CFL within the scene's bounds).
+  double suggested_time_step() const { return stepper_.suggested_time_step(); }
   std::int64_t step_count() const { return state_.step; }
   particles::ParticleSet& particles() { return state_.particles; }
   const materials::MaterialList& materials() const { return materials_; }

@@ -56,6 +56,8 @@ class Stepper {
   /// Advances to time t_end. Throws SimulationError if a step fails at the smallest Δt. Returns
   /// false when `after_step` asked to stop (the state is then that after the last step taken).
   bool advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr, const AfterStep& after_step = {});
+  /// The Δt the next step would try (CFL, bounds), before landing on the target time.
+  double suggested_time_step() const;
   /// Adds the particles the emitters owe by the state's time (every rank counts every layer and
   /// keeps the particles it owns), held inside the grid.
   void emit_particles();
@@ -77,8 +79,6 @@ class Stepper {
   /// Re-partitions the grid when the particle counts of the ranks drift apart (Grid/Rebalance
   /// threshold) and migrates the particles (collective).
   void rebalance_if_needed(RunSummary& summary, std::ostream* log);
-  /// The Δt the next step would try (CFL, bounds), before landing on the target time.
-  double suggested_time_step() const;
   /// One step of length dt, retried with smaller Δt until it is taken (or interrupted).
   void take_step(double dt, RunSummary& summary, std::ostream* log);
   /// Adds an attempt's counts (Newton, CG, timings) to the summary and solver.csv.

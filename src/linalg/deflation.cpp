@@ -1,0 +1,100 @@
+#include "deflation.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Teuchos_CommHelpers.hpp>
+
+namespace viscompm::linalg {
+
+DeflatedPreconditioner::DeflatedPreconditioner(const operator_type& A, Teuchos::RCP<operator_type> M,
+                                               Teuchos::RCP<const multivector_type> Z)
+    : M_(std::move(M)), Z_(std::move(Z)), k_(static_cast<int>(Z_->getNumVectors())) {
+  multivector_type AZ(Z_->getMap(), Z_->getNumVectors());
+  A.apply(*Z_, AZ);
+  // E = Zᵀ A Z (every rank the same), and its pseudo-inverse: modes A cannot tell apart (a body
+  // held by a sticky collider, two bodies' modes on the same nodes) are dropped.
+  std::vector<double> local(static_cast<std::size_t>(k_) * k_, 0.0), E(local.size());
+  {
+    auto z = Z_->getLocalViewHost(Tpetra::Access::ReadOnly);
+    auto az = AZ.getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (std::size_t i = 0; i < z.extent(0); ++i)
+      for (int a = 0; a < k_; ++a) {
+        if (z(i, a) == 0.0) continue;
+        for (int b = 0; b < k_; ++b) local[a * k_ + b] += z(i, a) * az(i, b);
+      }
+  }
+  Teuchos::reduceAll(*Z_->getMap()->getComm(), Teuchos::REDUCE_SUM, k_ * k_, local.data(), E.data());
+  Eigen::MatrixXd matrix = Eigen::Map<Eigen::MatrixXd>(E.data(), k_, k_);
+  matrix = 0.5 * (matrix + matrix.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(matrix);
+  const double largest = k_ > 0 ? eigen.eigenvalues().cwiseAbs().maxCoeff() : 0.0;
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(k_);
+  for (int a = 0; a < k_; ++a)
+    if (eigen.eigenvalues()[a] > 1e-12 * largest) {
+      inverse[a] = 1.0 / eigen.eigenvalues()[a];
+      ++rank_;
+    }
+  const Eigen::MatrixXd E_plus = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  pseudo_inverse_.resize(local.size());
+  for (int a = 0; a < k_; ++a)
+    for (int b = 0; b < k_; ++b) pseudo_inverse_[a * k_ + b] = E_plus(a, b);
+  z_rows_ = std::make_unique<SparseRows>(*Z_);
+  az_rows_ = std::make_unique<SparseRows>(AZ);
+}
+
+DeflatedPreconditioner::SparseRows::SparseRows(const multivector_type& V) {
+  auto v = V.getLocalViewHost(Tpetra::Access::ReadOnly);
+  row_start.reserve(v.extent(0) + 1);
+  row_start.push_back(0);
+  for (std::size_t i = 0; i < v.extent(0); ++i) {
+    for (std::size_t a = 0; a < v.extent(1); ++a)
+      if (v(i, a) != 0.0) {
+        column.push_back(static_cast<int>(a));
+        value.push_back(v(i, a));
+      }
+    row_start.push_back(column.size());
+  }
+}
+
+std::vector<double> DeflatedPreconditioner::project(const SparseRows& V, const vector_type& x) const {
+  std::vector<double> local(k_, 0.0), product(k_);
+  auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (std::size_t i = 0; i + 1 < V.row_start.size(); ++i)
+    for (std::size_t e = V.row_start[i]; e < V.row_start[i + 1]; ++e) local[V.column[e]] += V.value[e] * xv(i, 0);
+  Teuchos::reduceAll(*Z_->getMap()->getComm(), Teuchos::REDUCE_SUM, k_, local.data(), product.data());
+  std::vector<double> c(k_, 0.0);
+  for (int a = 0; a < k_; ++a)
+    for (int b = 0; b < k_; ++b) c[a] += pseudo_inverse_[a * k_ + b] * product[b];
+  return c;
+}
+
+void DeflatedPreconditioner::add_columns(const SparseRows& V, const std::vector<double>& c, double s,
+                                         vector_type& y) {
+  auto yv = y.getLocalViewHost(Tpetra::Access::ReadWrite);
+  for (std::size_t i = 0; i + 1 < V.row_start.size(); ++i) {
+    double sum = 0.0;
+    for (std::size_t e = V.row_start[i]; e < V.row_start[i + 1]; ++e) sum += V.value[e] * c[V.column[e]];
+    yv(i, 0) += s * sum;
+  }
+}
+
+void DeflatedPreconditioner::apply(const multivector_type& X, multivector_type& Y, Teuchos::ETransp, scalar_type alpha,
+                                   scalar_type beta) const {
+  for (std::size_t j = 0; j < X.getNumVectors(); ++j) {
+    const auto x = X.getVector(j);
+    // r' = (I − A Q) x, then z = M⁻¹ r' (or r' without M).
+    const std::vector<double> c = project(*z_rows_, *x);
+    vector_type r(*x, Teuchos::Copy);
+    add_columns(*az_rows_, c, -1.0, r);
+    vector_type z(Z_->getMap());
+    if (M_.is_null()) z.assign(r);
+    else M_->apply(r, z);
+    // (I − Q A) z + Q x.
+    const std::vector<double> d = project(*az_rows_, z);
+    add_columns(*z_rows_, d, -1.0, z);
+    add_columns(*z_rows_, c, 1.0, z);
+    auto y = Y.getVectorNonConst(j);
+    y->update(alpha, z, beta);
+  }
+}
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,36 @@
+// The lean V-cycle (solver files: Cycle = lean): viscompm applies the fine level itself and hands
+// the levels below to the MueLu hierarchy it built,
+//   x = S r;  x += P · V₁(R (r − A x));  x += S (r − A x),
+// with S the grid-line smoother (line_smoother.hpp), A the operator CG iterates with (assembled or
+// matrix-free), P and R level 1's prolongator and restrictor and V₁ one MueLu V-cycle from level 1
+// (Hierarchy::Iterate with startLevel 1). A fine level costs two products with A and two passes
+// of line solves: no smoother containers, no level-0 smoother object in MueLu. Symmetric (S and
+// V₁ are, R = Pᵀ), so CG applies. Private to src/linalg.
+#pragma once
+
+#include <memory>
+
+#include "line_smoother.hpp"
+#include "linalg_types.hpp"
+
+namespace viscompm::linalg {
+
+class LeanCycle : public operator_type {
+ public:
+  LeanCycle(Teuchos::RCP<const operator_type> A, std::shared_ptr<const LineSmoother> smoother,
+            Teuchos::RCP<muelu_hierarchy_type> hierarchy);
+
+  Teuchos::RCP<const map_type> getDomainMap() const override { return A_->getDomainMap(); }
+  Teuchos::RCP<const map_type> getRangeMap() const override { return A_->getRangeMap(); }
+  void apply(const multivector_type& X, multivector_type& Y, Teuchos::ETransp mode = Teuchos::NO_TRANS,
+             scalar_type alpha = Teuchos::ScalarTraits<scalar_type>::one(),
+             scalar_type beta = Teuchos::ScalarTraits<scalar_type>::zero()) const override;
+
+ private:
+  Teuchos::RCP<const operator_type> A_;
+  std::shared_ptr<const LineSmoother> smoother_;
+  Teuchos::RCP<muelu_hierarchy_type> hierarchy_;
+  Teuchos::RCP<const crs_matrix_type> P_, R_;
+};
+
+}  // namespace viscompm::linalg

@@ -1,0 +1,106 @@
+#include "line_smoother.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace viscompm::linalg {
+
+void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_A, double line_damping) {
+  const auto& rows = *A.getRowMap();
+  const auto& columns = *A.getColMap();
+  const std::size_t n = A.getNodeNumRows();
+  // Local column → local row (−1 for a ghost column).
+  std::vector<int> column_row(columns.getNodeNumElements());
+  for (std::size_t c = 0; c < column_row.size(); ++c)
+    column_row[c] = rows.getLocalElement(columns.getGlobalElement(static_cast<local_ordinal_type>(c)));
+  // Each node's position on its line of each axis (lines come axis by axis, one per node each).
+  const std::size_t nodes = n / 3;
+  std::vector<int> line_of(3 * nodes, -1), position_of(3 * nodes, -1);
+  std::vector<int> axis_of_line(lines_.size());
+  {
+    std::vector<int> seen(nodes, 0);
+    for (std::size_t l = 0; l < lines_.size(); ++l)
+      for (std::size_t k = 0; k < lines_[l].size(); ++k) {
+        const std::size_t node = lines_[l][k];
+        const int axis = seen[node]++;
+        if (axis > 2) throw std::logic_error("LineSmoother: a node on more than three lines");
+        if (k == 0) axis_of_line[l] = axis;
+        line_of[3 * node + axis] = static_cast<int>(l);
+        position_of[3 * node + axis] = static_cast<int>(k);
+      }
+  }
+  std::vector<Eigen::MatrixXd> blocks(lines_.size());
+  for (std::size_t l = 0; l < lines_.size(); ++l) blocks[l] = Eigen::MatrixXd::Zero(3 * lines_[l].size(), 3 * lines_[l].size());
+  for (std::size_t r = 0; r < n; ++r) {
+    crs_matrix_type::local_inds_host_view_type cols;
+    crs_matrix_type::values_host_view_type vals;
+    A.getLocalRowView(static_cast<local_ordinal_type>(r), cols, vals);
+    const std::size_t node = r / 3;
+    const int sigma = static_cast<int>(r % 3);
+    for (int axis = 0; axis < 3; ++axis) {
+      const int l = line_of[3 * node + axis];
+      if (l < 0) continue;
+      const int i = position_of[3 * node + axis];
+      for (std::size_t k = 0; k < cols.extent(0); ++k) {
+        const int row = column_row[cols(k)];
+        if (row < 0) continue;
+        const std::size_t other = static_cast<std::size_t>(row) / 3;
+        if (line_of[3 * other + axis] != l) continue;
+        blocks[l](3 * i + sigma, 3 * position_of[3 * other + axis] + row % 3) = vals(k);
+      }
+    }
+  }
+  factors_.resize(lines_.size());
+  for (std::size_t l = 0; l < lines_.size(); ++l) {
+    factors_[l].compute(blocks[l]);
+    if (factors_[l].info() != Eigen::Success)
+      throw std::runtime_error("LineSmoother: a line's block of H is not positive definite");
+  }
+  // The damping: Line damping over λmax(S A), by power iterations.
+  damping_ = 1.0;
+  int iterations = 5;
+  if (eigenvector_.is_null() || eigenvector_->getLocalLength() != n) {
+    eigenvector_ = Teuchos::rcp(new vector_type(apply_A.getDomainMap()));
+    auto view = eigenvector_->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    const auto& map = *apply_A.getDomainMap();
+    for (std::size_t i = 0; i < view.extent(0); ++i)
+      view(i, 0) = 1.0 + 0.5 * std::sin(1.7 * static_cast<double>(map.getGlobalElement(static_cast<local_ordinal_type>(i))));
+    iterations = 12;
+  }
+  vector_type& x = *eigenvector_;
+  vector_type y(apply_A.getRangeMap());
+  double lambda = 1.0;
+  for (int k = 0; k < iterations; ++k) {
+    x.scale(1.0 / x.norm2());
+    apply_A.apply(x, y);
+    apply(y, x);
+    lambda = x.norm2();
+  }
+  damping_ = line_damping / lambda;
+}
+
+template <class In, class Out>
+void LineSmoother::solve_blocks(const In& x, Out& y, std::size_t j) const {
+  Eigen::VectorXd b, z;
+  for (std::size_t l = 0; l < lines_.size(); ++l) {
+    const auto& line = lines_[l];
+    b.resize(3 * line.size());
+    for (std::size_t k = 0; k < line.size(); ++k)
+      for (int d = 0; d < 3; ++d) b[3 * k + d] = x(3 * line[k] + d, j);
+    z = factors_[l].solve(b);
+    for (std::size_t k = 0; k < line.size(); ++k)
+      for (int d = 0; d < 3; ++d) y(3 * line[k] + d, j) += z[3 * k + d];
+  }
+}
+
+void LineSmoother::apply(const multivector_type& x, multivector_type& y) const {
+  auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
+  auto yv = y.getLocalViewHost(Tpetra::Access::OverwriteAll);
+  for (std::size_t j = 0; j < xv.extent(1); ++j) {
+    for (std::size_t i = 0; i < xv.extent(0); ++i) yv(i, j) = 0.0;
+    solve_blocks(xv, yv, j);
+    for (std::size_t i = 0; i < xv.extent(0); ++i) yv(i, j) *= damping_;
+  }
+}
+
+}  // namespace viscompm::linalg

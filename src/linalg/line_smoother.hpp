@@ -1,0 +1,39 @@
+// Block Jacobi on grid lines, built and applied by viscompm (solver files: Cycle = lean): the
+// blocks are the runs of grid nodes along each axis (grid/node_lines), three dofs per node, each
+// factored once per set-up (Eigen's dense Cholesky of the block of H, at most 3 × Line length
+// rows) and applied as one pass of solves, summed over the overlapping lines:
+//   y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x,   ω = Line damping / λmax(Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ A).
+// The same blocks as Ifpack2's BLOCK_RELAXATION with user parts, without its per-application
+// copies into containers, weights and residual (measured: doc/performance.md). Private to src/linalg.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <vector>
+
+#include "linalg_types.hpp"
+
+namespace viscompm::linalg {
+
+class LineSmoother {
+ public:
+  /// Lines of the matrix's owned nodes (node k: rows 3k, 3k+1, 3k+2).
+  explicit LineSmoother(std::vector<std::vector<std::size_t>> lines) : lines_(std::move(lines)) {}
+  /// Factors every line's block of A (its owned rows); then estimates the damping with power
+  /// iterations of (blocks⁻¹ A) — 12 from a fixed start the first time, 5 from the last estimate
+  /// after that (collective).
+  void compute(const crs_matrix_type& A, const operator_type& apply_A, double line_damping);
+  /// y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x on the owned dofs.
+  void apply(const multivector_type& x, multivector_type& y) const;
+  double damping() const { return damping_; }
+
+ private:
+  /// y += Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x for column j (no damping).
+  template <class In, class Out>
+  void solve_blocks(const In& x, Out& y, std::size_t j) const;
+  std::vector<std::vector<std::size_t>> lines_;
+  std::vector<Eigen::LLT<Eigen::MatrixXd>> factors_;
+  double damping_ = 1.0;
+  Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate
+};
+
+}  // namespace viscompm::linalg
