@@ -45,8 +45,14 @@ check(result.returncode == 0, f"study exits 0: {result.stderr[-1500:]}")
 rows = list(csv.DictReader(open(os.path.join(out, "study.csv")))) if result.returncode == 0 else []
 check(rows and list(rows[0].keys()) == ["problem", "resolution", "dofs", "nonzeros", "ranks", "preconditioner",
                                         "setup_seconds", "solve_seconds", "iterations", "relative_residual",
-                                        "converged", "operator_seconds"], "study.csv columns")
+                                        "converged", "operator_seconds", "apply_seconds",
+                                        "preconditioner_apply_seconds", "peak_memory_mib"], "study.csv columns")
 check(all(float(r["operator_seconds"]) > 0.0 for r in rows), "every row counts the operator's preparation")
+check(all(float(r["apply_seconds"]) > 0.0 for r in rows), "every row times one application of H")
+check(all(float(r["preconditioner_apply_seconds"]) > 0.0 for r in rows),
+      "every row (all preconditioned here) times one application of the preconditioner")
+check(all(10.0 < float(r["peak_memory_mib"]) < 24 * 1024 for r in rows),
+      f"peak memory per rank in MiB: {[r['peak_memory_mib'] for r in rows]}")
 keys = [(r["problem"], r["resolution"], r["preconditioner"]) for r in rows]
 check(len(rows) == 2 * 2 * len(configs), f"{len(rows)} rows for 2 resolutions x 2 time steps x {len(configs)} solvers")
 check(len(set(keys)) == len(keys), "one row per (problem, resolution, preconditioner)")
@@ -57,6 +63,39 @@ sizes = {}
 for r in rows:
     sizes.setdefault((r["problem"], r["resolution"]), set()).add(r["dofs"])
 check(all(len(s) == 1 for s in sizes.values()), "dofs agree across configurations of a problem")
+# Several scenes, the time step a run takes (particle CFL) and a smallest cell size per scene:
+# with the scene's Max time step raised (a study-wide override) the sponge's bullet (4 m/s)
+# limits the step, CFL·Δx/|v| at both sizes (∝ Δx), and the entry with Smallest cell size 0.07
+# leaves out 0.06.
+scenes_study = os.path.join(args.workdir, "scenes.xml")
+with open(scenes_study, "w") as f:
+    f.write(f"""<ParameterList name="s">
+  <Parameter name="Cell sizes" type="Array(double)" value="{{0.075, 0.06}}"/>
+  <Parameter name="Time steps" type="Array(double)" value="{{1}}"/>
+  <Parameter name="Time step unit" type="string" value="particle CFL"/>
+  <Parameter name="Scene overrides" type="Array(string)" value="{{Simulation/Max time step=0.1}}"/>
+  <ParameterList name="Scenes">
+    <ParameterList name="sponge">
+      <Parameter name="Scene" type="string" value="{args.inputs}/scenes/shooting_sponge.xml"/>
+    </ParameterList>
+    <ParameterList name="sponge moved">
+      <Parameter name="Scene" type="string" value="{args.inputs}/scenes/shooting_sponge.xml"/>
+      <Parameter name="Smallest cell size" type="double" value="0.07"/>
+    </ParameterList>
+  </ParameterList>
+  <Parameter name="Solvers" type="Array(string)" value="{{{os.path.join(solvers, "jacobi_cg.xml")}}}"/>
+  <Parameter name="Plot" type="bool" value="false"/>
+</ParameterList>""")
+result = run(args.study, scenes_study, "--output", out + "_scenes")
+check(result.returncode == 0, f"a study of two scenes exits 0: {result.stderr[-1500:]}")
+rows = list(csv.DictReader(open(os.path.join(out + "_scenes", "study.csv")))) if result.returncode == 0 else []
+check(sorted((r["problem"].split(" t=")[0], r["resolution"]) for r in rows)
+      == [("sponge", "0.06"), ("sponge", "0.075"), ("sponge moved", "0.075")],
+      f"one row per scene and cell size, 0.06 left out for the second: {[(r['problem'], r['resolution']) for r in rows]}")
+steps = {r["resolution"]: float(r["problem"].split("dt=")[1].split("s")[0]) for r in rows if r["problem"].startswith("sponge t=")}
+check(len(steps) == 2 and abs(steps["0.06"] / steps["0.075"] - 0.06 / 0.075) < 0.02,
+      f"the particle-CFL step scales with the cell: {steps}")
+
 # Unpreconditioned CG that cannot converge in its iteration budget is a row, not a crash.
 budget = os.path.join(args.workdir, "tiny_budget.xml")
 with open(budget, "w") as f:
