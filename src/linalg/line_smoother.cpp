@@ -1,7 +1,15 @@
 #include "line_smoother.hpp"
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <stdexcept>
+
+// LAPACK's banded Cholesky (Teuchos::LAPACK has no PBTRF/PBTRS).
+extern "C" {
+void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
+void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab, const int* ldab,
+             double* b, const int* ldb, int* info);
+}
 
 namespace viscompm::linalg {
 
@@ -52,9 +60,20 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
   }
   factors_.resize(lines_.size());
   for (std::size_t l = 0; l < lines_.size(); ++l) {
-    factors_[l].compute(blocks[l]);
-    if (factors_[l].info() != Eigen::Success)
-      throw std::runtime_error("LineSmoother: a line's block of H is not positive definite");
+    const Eigen::MatrixXd& block = blocks[l];
+    BandFactor& f = factors_[l];
+    f.rows = static_cast<int>(block.rows());
+    f.bandwidth = 0;
+    for (int j = 0; j < f.rows; ++j)
+      for (int i = f.rows - 1; i > j + f.bandwidth; --i)
+        if (block(i, j) != 0.0) f.bandwidth = i - j;
+    const int ld = f.bandwidth + 1;
+    f.band.assign(static_cast<std::size_t>(ld) * f.rows, 0.0);
+    for (int j = 0; j < f.rows; ++j)
+      for (int i = j; i <= std::min(f.rows - 1, j + f.bandwidth); ++i) f.band[j * ld + (i - j)] = block(i, j);
+    int info = 0;
+    dpbtrf_("L", &f.rows, &f.bandwidth, f.band.data(), &ld, &info);
+    if (info != 0) throw std::runtime_error("LineSmoother: a line's block of H is not positive definite");
   }
   // The damping: Line damping over λmax(S A), by power iterations.
   damping_ = 1.0;
@@ -81,15 +100,19 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
 
 template <class In, class Out>
 void LineSmoother::solve_blocks(const In& x, Out& y, std::size_t j) const {
-  Eigen::VectorXd b, z;
+  std::vector<double> b;
+  const int one = 1;
   for (std::size_t l = 0; l < lines_.size(); ++l) {
     const auto& line = lines_[l];
+    const BandFactor& f = factors_[l];
     b.resize(3 * line.size());
     for (std::size_t k = 0; k < line.size(); ++k)
       for (int d = 0; d < 3; ++d) b[3 * k + d] = x(3 * line[k] + d, j);
-    z = factors_[l].solve(b);
+    const int ld = f.bandwidth + 1;
+    int info = 0;
+    dpbtrs_("L", &f.rows, &f.bandwidth, &one, f.band.data(), &ld, b.data(), &f.rows, &info);
     for (std::size_t k = 0; k < line.size(); ++k)
-      for (int d = 0; d < 3; ++d) y(3 * line[k] + d, j) += z[3 * k + d];
+      for (int d = 0; d < 3; ++d) y(3 * line[k] + d, j) += b[3 * k + d];
   }
 }
 

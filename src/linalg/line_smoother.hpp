@@ -1,13 +1,13 @@
 // Block Jacobi on grid lines, built and applied by viscompm (solver files: Cycle = lean): the
 // blocks are the runs of grid nodes along each axis (grid/node_lines), three dofs per node, each
-// factored once per set-up (Eigen's dense Cholesky of the block of H, at most 3 × Line length
-// rows) and applied as one pass of solves, summed over the overlapping lines:
+// factored once per set-up (LAPACK's banded Cholesky, dpbtrf, of the block of H: at most
+// 3 × Line length rows, nodes coupled to the next two along the line, so a band of 8 below the
+// diagonal) and applied as one pass of banded solves (dpbtrs), summed over the overlapping lines:
 //   y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x,   ω = Line damping / λmax(Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ A).
 // The same blocks as Ifpack2's BLOCK_RELAXATION with user parts, without its per-application
 // copies into containers, weights and residual (measured: doc/performance.md). Private to src/linalg.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <vector>
 
 #include "linalg_types.hpp"
@@ -30,8 +30,13 @@ class LineSmoother {
   /// y += Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x for column j (no damping).
   template <class In, class Out>
   void solve_blocks(const In& x, Out& y, std::size_t j) const;
+  /// A line's block factored by dpbtrf, lower band storage: (bandwidth + 1) × rows, column-major.
+  struct BandFactor {
+    int rows = 0, bandwidth = 0;
+    std::vector<double> band;
+  };
   std::vector<std::vector<std::size_t>> lines_;
-  std::vector<Eigen::LLT<Eigen::MatrixXd>> factors_;
+  std::vector<BandFactor> factors_;
   double damping_ = 1.0;
   Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate
 };
