@@ -1,3 +1,4 @@
+#include <Teuchos_TimeMonitor.hpp>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -52,6 +53,11 @@ int run_study_program(int argc, char** argv) {
     }
     const study::StudySettings settings = study::read_study(cl.input_file, cl.overrides);
     const int rows = study::run_study(settings, cl.input_file, comm, std::cout);
+    // Where the lean cycles' and the deflation's time went (all configurations that used them).
+    if (!Teuchos::TimeMonitor::lookupCounter("viscompm: lean cycle: 1 line smoother").is_null())
+      Teuchos::TimeMonitor::summarize(std::cout, false, true, false, Teuchos::Union, "viscompm: lean cycle");
+    if (!Teuchos::TimeMonitor::lookupCounter("viscompm: deflation: projections").is_null())
+      Teuchos::TimeMonitor::summarize(std::cout, false, true, false, Teuchos::Union, "viscompm: deflation");
     const bool steps = settings.mode == study::StudyMode::steps;
     const std::string csv = settings.output_directory + (steps ? "/steps.csv" : "/study.csv");
     if (root) {

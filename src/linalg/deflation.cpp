@@ -2,8 +2,17 @@
 
 #include <Eigen/Eigenvalues>
 #include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_TimeMonitor.hpp>
 
 namespace viscompm::linalg {
+
+namespace {
+// The deflation's own work per application (M excluded), printed with the programs' timers.
+Teuchos::Time& deflation_timer() {
+  static Teuchos::Time& t = *Teuchos::TimeMonitor::getNewCounter("viscompm: deflation: projections");
+  return t;
+}
+}  // namespace
 
 DeflatedPreconditioner::DeflatedPreconditioner(const operator_type& A, Teuchos::RCP<operator_type> M,
                                                Teuchos::RCP<const multivector_type> Z)
@@ -82,16 +91,22 @@ void DeflatedPreconditioner::apply(const multivector_type& X, multivector_type& 
   for (std::size_t j = 0; j < X.getNumVectors(); ++j) {
     const auto x = X.getVector(j);
     // r' = (I − A Q) x, then z = M⁻¹ r' (or r' without M).
-    const std::vector<double> c = project(*z_rows_, *x);
-    vector_type r(*x, Teuchos::Copy);
-    add_columns(*az_rows_, c, -1.0, r);
-    vector_type z(Z_->getMap());
+    std::vector<double> c;
+    vector_type r(*x, Teuchos::Copy), z(Z_->getMap());
+    {
+      Teuchos::TimeMonitor t(deflation_timer());
+      c = project(*z_rows_, *x);
+      add_columns(*az_rows_, c, -1.0, r);
+    }
     if (M_.is_null()) z.assign(r);
     else M_->apply(r, z);
     // (I − Q A) z + Q x.
-    const std::vector<double> d = project(*az_rows_, z);
-    add_columns(*z_rows_, d, -1.0, z);
-    add_columns(*z_rows_, c, 1.0, z);
+    {
+      Teuchos::TimeMonitor t(deflation_timer());
+      const std::vector<double> d = project(*az_rows_, z);
+      add_columns(*z_rows_, d, -1.0, z);
+      add_columns(*z_rows_, c, 1.0, z);
+    }
     auto y = Y.getVectorNonConst(j);
     y->update(alpha, z, beta);
   }

@@ -2,8 +2,18 @@
 
 #include <MueLu_Hierarchy.hpp>
 #include <MueLu_Utilities.hpp>
+#include <Teuchos_TimeMonitor.hpp>
 
 namespace viscompm::linalg {
+
+namespace {
+// Where a cycle's time goes, printed with the programs' timers ("viscompm: lean cycle: ...").
+Teuchos::Time& timer(const char* name) { return *Teuchos::TimeMonitor::getNewCounter(name); }
+Teuchos::Time& smoother_timer() { static Teuchos::Time& t = timer("viscompm: lean cycle: 1 line smoother"); return t; }
+Teuchos::Time& residual_timer() { static Teuchos::Time& t = timer("viscompm: lean cycle: 2 fine residuals"); return t; }
+Teuchos::Time& transfer_timer() { static Teuchos::Time& t = timer("viscompm: lean cycle: 3 restrict, prolong"); return t; }
+Teuchos::Time& coarse_timer() { static Teuchos::Time& t = timer("viscompm: lean cycle: 4 coarse levels"); return t; }
+}  // namespace
 
 LeanCycle::LeanCycle(Teuchos::RCP<const operator_type> A, std::shared_ptr<const LineSmoother> smoother,
                      Teuchos::RCP<muelu_hierarchy_type> hierarchy)
@@ -20,19 +30,40 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
   auto coarse_b = Teuchos::rcp(new multivector_type(R_->getRangeMap(), k));
   auto coarse_x = Teuchos::rcp(new multivector_type(P_->getDomainMap(), k));
   // Pre-smoothing from zero.
-  smoother_->apply(X, x);
+  {
+    Teuchos::TimeMonitor t(smoother_timer());
+    smoother_->apply(X, x);
+  }
   // Coarse correction of the residual.
-  A_->apply(x, residual);
-  residual.update(1.0, X, -1.0);
-  R_->apply(residual, *coarse_b);
-  coarse_x->putScalar(0.0);
-  hierarchy_->Iterate(*MueLu::TpetraMultiVector_To_XpetraMultiVector(coarse_b),
-                      *MueLu::TpetraMultiVector_To_XpetraMultiVector(coarse_x), 1, true, 1);
-  P_->apply(*coarse_x, x, Teuchos::NO_TRANS, 1.0, 1.0);
+  {
+    Teuchos::TimeMonitor t(residual_timer());
+    A_->apply(x, residual);
+    residual.update(1.0, X, -1.0);
+  }
+  {
+    Teuchos::TimeMonitor t(transfer_timer());
+    R_->apply(residual, *coarse_b);
+  }
+  {
+    Teuchos::TimeMonitor t(coarse_timer());
+    coarse_x->putScalar(0.0);
+    hierarchy_->Iterate(*MueLu::TpetraMultiVector_To_XpetraMultiVector(coarse_b),
+                        *MueLu::TpetraMultiVector_To_XpetraMultiVector(coarse_x), 1, true, 1);
+  }
+  {
+    Teuchos::TimeMonitor t(transfer_timer());
+    P_->apply(*coarse_x, x, Teuchos::NO_TRANS, 1.0, 1.0);
+  }
   // Post-smoothing.
-  A_->apply(x, residual);
-  residual.update(1.0, X, -1.0);
-  smoother_->apply(residual, correction);
+  {
+    Teuchos::TimeMonitor t(residual_timer());
+    A_->apply(x, residual);
+    residual.update(1.0, X, -1.0);
+  }
+  {
+    Teuchos::TimeMonitor t(smoother_timer());
+    smoother_->apply(residual, correction);
+  }
   x.update(1.0, correction, 1.0);
   Y.update(alpha, x, beta);
 }
