@@ -77,25 +77,31 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
   }
   // The damping: Line damping over λmax(S A), by power iterations.
   damping_ = 1.0;
+  damping_ = line_damping / smoothed_largest_eigenvalue(
+                                apply_A, [this](const vector_type& in, vector_type& out) { apply(in, out); }, eigenvector_);
+}
+
+double smoothed_largest_eigenvalue(const operator_type& A, const std::function<void(const vector_type&, vector_type&)>& smooth,
+                                   Teuchos::RCP<vector_type>& eigenvector) {
   int iterations = 5;
-  if (eigenvector_.is_null() || eigenvector_->getLocalLength() != n) {
-    eigenvector_ = Teuchos::rcp(new vector_type(apply_A.getDomainMap()));
-    auto view = eigenvector_->getLocalViewHost(Tpetra::Access::OverwriteAll);
-    const auto& map = *apply_A.getDomainMap();
+  if (eigenvector.is_null() || eigenvector->getLocalLength() != A.getDomainMap()->getNodeNumElements()) {
+    eigenvector = Teuchos::rcp(new vector_type(A.getDomainMap()));
+    auto view = eigenvector->getLocalViewHost(Tpetra::Access::OverwriteAll);
+    const auto& map = *A.getDomainMap();
     for (std::size_t i = 0; i < view.extent(0); ++i)
       view(i, 0) = 1.0 + 0.5 * std::sin(1.7 * static_cast<double>(map.getGlobalElement(static_cast<local_ordinal_type>(i))));
     iterations = 12;
   }
-  vector_type& x = *eigenvector_;
-  vector_type y(apply_A.getRangeMap());
+  vector_type& x = *eigenvector;
+  vector_type y(A.getRangeMap());
   double lambda = 1.0;
   for (int k = 0; k < iterations; ++k) {
     x.scale(1.0 / x.norm2());
-    apply_A.apply(x, y);
-    apply(y, x);
+    A.apply(x, y);
+    smooth(y, x);
     lambda = x.norm2();
   }
-  damping_ = line_damping / lambda;
+  return lambda;
 }
 
 template <class In, class Out>

@@ -8,11 +8,18 @@
 // copies into containers, weights and residual (measured: doc/performance.md). Private to src/linalg.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "linalg_types.hpp"
 
 namespace viscompm::linalg {
+
+/// λmax of S A by power iterations (S a smoother applied as `smooth(in, out)`): 12 from a fixed
+/// start when `eigenvector` is null or of another length, 5 from the last estimate's vector after
+/// that; `eigenvector` keeps the vector for the next estimate (collective).
+double smoothed_largest_eigenvalue(const operator_type& A, const std::function<void(const vector_type&, vector_type&)>& smooth,
+                                   Teuchos::RCP<vector_type>& eigenvector);
 
 class LineSmoother {
  public:

@@ -91,24 +91,8 @@ class GridLines {
     one_sweep.set("relaxation: sweeps", 1);
     one_sweep.set("relaxation: zero starting solution", true);
     smoother.setParameters(one_sweep);
-    int iterations = 5;
-    if (eigenvector_.is_null()) {
-      eigenvector_ = Teuchos::rcp(new vector_type(A.getDomainMap()));
-      auto view = eigenvector_->getLocalViewHost(Tpetra::Access::OverwriteAll);
-      const auto& map = *A.getDomainMap();
-      for (std::size_t i = 0; i < view.extent(0); ++i)
-        view(i, 0) = 1.0 + 0.5 * std::sin(1.7 * static_cast<double>(map.getGlobalElement(static_cast<local_ordinal_type>(i))));
-      iterations = 12;
-    }
-    vector_type& x = *eigenvector_;
-    vector_type y(A.getRangeMap());
-    double lambda = 0.0;
-    for (int k = 0; k < iterations; ++k) {
-      x.scale(1.0 / x.norm2());
-      A.apply(x, y);
-      smoother.apply(y, x);
-      lambda = x.norm2();
-    }
+    const double lambda = smoothed_largest_eigenvalue(
+        A, [&smoother](const vector_type& in, vector_type& out) { smoother.apply(in, out); }, eigenvector_);
     Teuchos::ParameterList damped = list_;
     damped.set("relaxation: damping factor", settings.line_damping / lambda);
     smoother.setParameters(damped);
