@@ -6,6 +6,7 @@
 #include <set>
 #include <tuple>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
@@ -254,6 +255,23 @@ TEST(CommandLine, RepeatedOptionsAndParametersSetTwiceAreRejected) {
     EXPECT_EQ(m.find("Simulation/Frames"), std::string::npos) << m;
   }
   EXPECT_EQ(error({"viscompm", "scene.xml", "--set", "A/B=1", "--set", "C/D=2", "--frames", "0"}), "");
+}
+
+// --restart is an optional value, not an empty-string switch: absent is no restart, given empty is
+// bad input (it used to mean "no restart").
+TEST(CommandLine, RestartIsGivenOrNot) {
+  const scene::ProgramOptions options{"viscompm", "test"};
+  const char* plain[] = {"viscompm", "scene.xml"};
+  EXPECT_FALSE(scene::parse_command_line(2, plain, options).restart_file.has_value());
+  const char* restart[] = {"viscompm", "scene.xml", "--restart", "c.h5"};
+  EXPECT_EQ(scene::parse_command_line(4, restart, options).restart_file, std::optional<std::string>("c.h5"));
+  const char* empty[] = {"viscompm", "scene.xml", "--restart="};
+  try {
+    scene::parse_command_line(3, empty, options);
+    ADD_FAILURE() << "--restart= was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "command line: option --restart: needs a checkpoint file");
+  }
 }
 
 TEST(Scene, AMissingSolverFileNamesTheSceneAndTheParameter) {
