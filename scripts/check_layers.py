@@ -54,10 +54,25 @@ def folder_of(path, root):
     return parts[2]  # include/viscompm/<folder>/
 
 
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, not argparse's usage block
+        self.exit(2, f"{self.prog}: {message} (see --help)\n")
+
+
+def fail(message):
+    sys.stderr.write(f"check_layers.py: {message}\n")
+    sys.exit(2)
+
+
 def main():
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = Parser(description=__doc__ + " A root that is not a viscompm source tree, or a file that "
+                    "cannot be read, is one line naming it, exit 2.")
     parser.add_argument("root", nargs="?", default=pathlib.Path(__file__).resolve().parent.parent, type=pathlib.Path)
     root = parser.parse_args().root
+    if not root.is_dir():
+        fail(f"{root}: no such directory")
+    if not (root / "src").is_dir() or not (root / "include" / "viscompm").is_dir():
+        fail(f"{root}: not a viscompm source tree (no src/ and include/viscompm/)")
     files = sorted(
         [*root.glob("src/*/**/*.[ch]pp"), *root.glob("include/viscompm/*/**/*.hpp"), *root.glob("apps/*.cpp")])
     violations, known_seen = [], set()
@@ -76,7 +91,11 @@ def main():
             violations.append(f"{path.relative_to(root)}: folder '{folder}' is not in the layer table "
                               "(scripts/check_layers.py and doc/architecture.md)")
             continue
-        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+        try:
+            text = path.read_text(errors="replace")
+        except OSError as e:
+            fail(f"{path}: cannot read ({e.strerror or e})")
+        for number, line in enumerate(text.splitlines(), 1):
             match = INCLUDE.match(line)
             if match and match.group(1) != folder and match.group(1) not in ALLOWED[folder]:
                 report(path, match.group(1), f"{path.relative_to(root)}:{number}: {folder}/ may not include "

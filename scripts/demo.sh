@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Builds viscompm (installing what is missing) and runs the default scene, a small shooting
 # sponge (Figure 5.2), on all cores. Usage: scripts/demo.sh [extra viscompm options]
+# VISCOMPM_RANKS (a positive whole number) is checked before anything is built, the options by
+# viscompm (one line naming the option, exit 2).
 set -euo pipefail
+RANKS="${VISCOMPM_RANKS:-$(nproc)}"
+[[ "$RANKS" =~ ^[1-9][0-9]{0,4}$ ]] || { echo "demo.sh: VISCOMPM_RANKS='$RANKS' is not a positive whole number" >&2; exit 2; }
 source "$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/setup.sh"
 
 OUTPUT="${VISCOMPM_DEMO_OUTPUT:-$VISCOMPM_ROOT/output/shooting_sponge}"
-RANKS="${VISCOMPM_RANKS:-$(nproc)}"
 mpiexec -np "$RANKS" "$BUILD_DIR/bin/viscompm" "$VISCOMPM_ROOT/inputs/scenes/shooting_sponge.xml" --output "$OUTPUT" "$@"
 echo
 echo "Output: $OUTPUT"

@@ -8,13 +8,19 @@ downloaded. Both are closed, consistently oriented triangle meshes (outward norm
                    its head, binary STL, ~0.19 m long, handle bottom at y = 0
 
 Usage: scripts/make_meshes.py [OUTPUT_DIR]   (default: inputs/meshes next to this script)
+
+An OUTPUT_DIR that cannot be made or written to is one line on stderr naming it, exit 2.
 """
+import argparse
 import math
 import os
 import struct
 import sys
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError:
+    sys.exit("make_meshes.py: needs numpy (Debian: python3-numpy; scripts/setup.sh installs it)")
 
 
 def sphere_grid(radius_of, rings=48, segments=96, centre=(0.0, 0.0, 0.0)):
@@ -148,13 +154,36 @@ def write_binary_stl(path, verts, tris, comment):
             f.write(struct.pack("<12fH", *n, *verts[a], *verts[b], *verts[c], 0))
 
 
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, not argparse's usage block
+        self.exit(2, f"{self.prog}: {message} (see --help)\n")
+
+
+def fail(message):
+    sys.stderr.write(f"make_meshes.py: {message}\n")
+    sys.exit(2)
+
+
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "inputs", "meshes")
-    os.makedirs(out, exist_ok=True)
+    parser = Parser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("output_dir", nargs="?",
+                        default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "inputs", "meshes"))
+    out = parser.parse_args().output_dir
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        fail(f"{out}: cannot make the directory ({e.strerror or e})")
+    if not os.access(out, os.W_OK):
+        fail(f"{out}: cannot write to the directory")
     v, t = head()
-    write_obj(os.path.join(out, "head.obj"), v, t, "stylised mannequin head on a neck, metres, y up, face toward -x")
-    v, t = toothbrush()
-    write_binary_stl(os.path.join(out, "toothbrush.stl"), v, t, "toothbrush, metres, y up, bristles on +y")
+    path = os.path.join(out, "head.obj")
+    try:
+        write_obj(path, v, t, "stylised mannequin head on a neck, metres, y up, face toward -x")
+        v, t = toothbrush()
+        path = os.path.join(out, "toothbrush.stl")
+        write_binary_stl(path, v, t, "toothbrush, metres, y up, bristles on +y")
+    except OSError as e:
+        fail(f"{path}: cannot write ({e.strerror or e})")
     print(f"wrote head.obj and toothbrush.stl to {out}")
 
 

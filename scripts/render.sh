@@ -12,12 +12,21 @@
 #          [--size WxH] [--frames all|last|N,M,...] [--range LO HI] [--view iso|x|y|z]
 #          [--azimuth DEG] [--elevation DEG] [--zoom F] [--focus X,Y,Z] [--clip x|y|z]
 #          [--fps N] [--no-movie] [--strip N,M,... --strip-file FILE.png [--strip-width W]]
+#
+# A missing or bad option value, a missing directory or a frame that cannot be read (cut short,
+# damaged) is one line on stderr naming the option or the file, exit 2 (doc/contracts.md).
 set -euo pipefail
 
 usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
-if [ $# -lt 1 ] || [ "$1" = "--help" ] || [ "$1" = "-h" ]; then usage; [ $# -ge 1 ] && exit 0 || exit 2; fi
+fail() { echo "render.sh: $*" >&2; exit 2; }
+if [ $# -ge 1 ] && { [ "$1" = "--help" ] || [ "$1" = "-h" ]; }; then usage; exit 0; fi
+[ $# -ge 1 ] || fail "missing OUTPUT_DIR (usage: scripts/render.sh OUTPUT_DIR [options]; see --help)"
 OUTPUT_DIR="$1"; shift
-if [ ! -d "$OUTPUT_DIR" ]; then echo "render.sh: $OUTPUT_DIR: no such directory" >&2; exit 2; fi
+case "$OUTPUT_DIR" in -*) fail "missing OUTPUT_DIR before '$OUTPUT_DIR' (see --help)" ;; esac
+if [ ! -d "$OUTPUT_DIR" ]; then fail "$OUTPUT_DIR: no such directory"; fi
+# The value of option $1 (given $# - 1 words after it), or a one-line error.
+value_of() { [ "$2" -ge 2 ] || fail "$1 needs a value (see --help)"; }
+whole() { [[ "$2" =~ ^[1-9][0-9]{0,5}$ ]] || fail "$1: '$2' is not a positive whole number"; }
 
 FPS=24
 MOVIE=1
@@ -27,17 +36,19 @@ STRIP_WIDTH=1280
 forward=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --fps) FPS="$2"; shift 2 ;;
+    --fps) value_of "$1" $#; whole "$1" "$2"; FPS="$2"; shift 2 ;;
     --no-movie) MOVIE=0; shift ;;
-    --strip) STRIP="$2"; shift 2 ;;
-    --strip-file) STRIP_FILE="$2"; shift 2 ;;
-    --strip-width) STRIP_WIDTH="$2"; shift 2 ;;
-    --range) forward+=("$1" "$2" "$3"); shift 3 ;;
-    --field|--style|--size|--frames|--view|--clip|--azimuth|--elevation|--zoom|--focus) forward+=("$1=$2"); shift 2 ;;  # "=": values may be negative
-    *) echo "render.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+    --strip) value_of "$1" $#; [[ "$2" =~ ^[0-9]+(,[0-9]+)*$ ]] || fail "--strip: '$2' is not frame numbers separated by commas"
+             STRIP="$2"; shift 2 ;;
+    --strip-file) value_of "$1" $#; STRIP_FILE="$2"; shift 2 ;;
+    --strip-width) value_of "$1" $#; whole "$1" "$2"; STRIP_WIDTH="$2"; shift 2 ;;
+    --range) [ $# -ge 3 ] || fail "--range needs two values, LO HI (see --help)"; forward+=("$1" "$2" "$3"); shift 3 ;;
+    --field|--style|--size|--frames|--view|--clip|--azimuth|--elevation|--zoom|--focus) value_of "$1" $#; forward+=("$1=$2"); shift 2 ;;  # "=": values may be negative
+    *) fail "unknown option '$1' (see --help)" ;;
   esac
 done
-if [ -n "$STRIP" ] && [ -z "$STRIP_FILE" ]; then echo "render.sh: --strip needs --strip-file FILE.png" >&2; exit 2; fi
+if [ -n "$STRIP" ] && [ -z "$STRIP_FILE" ]; then fail "--strip needs --strip-file FILE.png"; fi
+if [ -n "$STRIP_FILE" ] && [ ! -d "$(dirname "$STRIP_FILE")" ]; then fail "--strip-file: $(dirname "$STRIP_FILE"): no such directory"; fi
 
 packages=(paraview python3-paraview python3-h5py xvfb xauth ffmpeg)
 missing=()
@@ -78,7 +89,7 @@ if [ -n "$STRIP" ]; then
   IFS=',' read -r -a strip_frames <<< "$STRIP"
   for f in "${strip_frames[@]}"; do
     png=$(printf '%s/render/frame_%05d.png' "$OUTPUT_DIR" "$f")
-    [ -f "$png" ] || { echo "render.sh: $png not rendered (add frame $f to --frames)" >&2; exit 2; }
+    [ -f "$png" ] || fail "--strip: $png not rendered (add frame $f to --frames)"
     inputs+=(-i "$png")
   done
   n=${#strip_frames[@]}

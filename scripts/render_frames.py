@@ -16,6 +16,10 @@ Styles:
 The default colouring is det b^E (b^E = left_cauchy_green_elastic, (5.5)), centred at 1 as in
 Figure 5.7: red above 1, blue below. Other fields: any /particles dataset (vectors and tensors by
 their magnitude), or none (one cream colour). Colliders are grey translucent surfaces.
+
+A bad option value, or a frame that cannot be read (cut short by a killed run or a full disk,
+without the datasets a frame has), is one line on stderr naming the option or the file, exit 2
+(doc/contracts.md).
 """
 import argparse
 import glob
@@ -24,35 +28,125 @@ import os
 import re
 import sys
 
-import h5py
-import numpy as np
-from paraview import simple
-from paraview.vtk.util import numpy_support
-from vtkmodules.vtkCommonCore import vtkPoints
-from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-from vtkmodules.vtkFiltersCore import vtkWindowedSincPolyDataFilter
-from vtkmodules.vtkIOGeometry import vtkOBJReader
+try:
+    import h5py
+    import numpy as np
+    from paraview import simple
+    from paraview.vtk.util import numpy_support
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+    from vtkmodules.vtkFiltersCore import vtkWindowedSincPolyDataFilter
+    from vtkmodules.vtkIOGeometry import vtkOBJReader
+except ImportError as missing:
+    sys.exit(f"render: needs {missing.name} (run under ParaView's pvbatch, as scripts/render.sh does; "
+             "Debian: paraview python3-paraview python3-h5py)")
 
 CREAM = [0.95, 0.9, 0.78]
 SPONGE = [0.93, 0.78, 0.35]
 
 
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, not argparse's usage block
+        self.exit(2, f"render: {message} (see scripts/render.sh --help)\n")
+
+
+def fail(message):
+    sys.stderr.write(f"render: {message}\n")
+    sys.exit(2)
+
+
+# The frame file being read, named when it turns out damaged (main).
+reading = None
+
+
+class Frame:
+    """A frame file opened for reading, its datasets checked: `with Frame(path) as h5:`."""
+
+    def __init__(self, path, field="none"):
+        self.path, self.field = path, field
+
+    def __enter__(self):
+        global reading
+        reading = self.path
+        self.h5 = h5py.File(self.path, "r")
+        p = self.h5.get("particles")
+        if not isinstance(p, h5py.Group) or "position" not in p:
+            raise KeyError("no /particles/position")
+        n = p["position"].shape[0] if p["position"].ndim == 2 and p["position"].shape[1:] == (3,) else -1
+        if n < 0:
+            raise ValueError(f"/particles/position has shape {p['position'].shape}, not (n, 3)")
+        needed = ["volume0"] + (["left_cauchy_green_elastic"] if self.field == "det_b_elastic" else [])
+        for name in needed:
+            if name not in p or p[name].shape[:1] != (n,):
+                raise KeyError(f"no /particles/{name} of {n} rows")
+        if "time" not in self.h5.attrs:
+            raise KeyError("no 'time' attribute")
+        return self.h5
+
+    def __exit__(self, kind, value, traceback):
+        global reading
+        self.h5.close()
+        if kind is None:
+            reading = None
+        return False
+
+
+def positive_size(text):
+    match = re.fullmatch(r"(\d+)x(\d+)", text.lower())
+    if not match or int(match.group(1)) == 0 or int(match.group(2)) == 0:
+        raise argparse.ArgumentTypeError(f"'{text}' is not WxH (e.g. 1280x720)")
+    return int(match.group(1)), int(match.group(2))
+
+
+def frame_list(text):
+    if text in ("all", "last") or re.fullmatch(r"\d+(,\d+)*", text):
+        return text
+    raise argparse.ArgumentTypeError(f"'{text}' is not all, last or frame numbers separated by commas")
+
+
+def point(text):
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"'{text}' is not X,Y,Z (three finite numbers)")
+    return values
+
+
+def finite(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number")
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"'{text}' is not a finite number")
+    return value
+
+
+def positive(text):
+    value = finite(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"'{text}' is not positive")
+    return value
+
+
 def parse():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = Parser(prog="render", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("output_dir")
     ap.add_argument("--field", default="det_b_elastic",
                     help="det_b_elastic (default), a /particles dataset such as velocity or material_id, or none")
     ap.add_argument("--style", default="auto", choices=["auto", "spheres", "surface", "density"])
-    ap.add_argument("--size", default="1280x720", help="image size WxH (default 1280x720)")
-    ap.add_argument("--frames", default="all", help="all (default), last, or frame numbers separated by commas")
-    ap.add_argument("--range", nargs=2, type=float, metavar=("LO", "HI"),
+    ap.add_argument("--size", default="1280x720", type=positive_size, help="image size WxH (default 1280x720)")
+    ap.add_argument("--frames", default="all", type=frame_list, help="all (default), last, or frame numbers separated by commas")
+    ap.add_argument("--range", nargs=2, type=finite, metavar=("LO", "HI"),
                     help="colour range (default: det_b_elastic 1 ± the 95th percentile of |det b^E - 1| in the "
                          "rendered frames)")
     ap.add_argument("--view", default="iso", choices=["iso", "x", "y", "z"], help="camera direction (default iso)")
-    ap.add_argument("--azimuth", type=float, default=0.0, help="turn the camera about the up axis [degrees]")
-    ap.add_argument("--elevation", type=float, default=0.0, help="raise the camera [degrees]")
-    ap.add_argument("--zoom", type=float, default=1.0, help="> 1 moves the camera closer (default 1)")
-    ap.add_argument("--focus", help="X,Y,Z: the point the camera looks at (default the middle of the particles)")
+    ap.add_argument("--azimuth", type=finite, default=0.0, help="turn the camera about the up axis [degrees]")
+    ap.add_argument("--elevation", type=finite, default=0.0, help="raise the camera [degrees]")
+    ap.add_argument("--zoom", type=positive, default=1.0, help="> 1 moves the camera closer (default 1)")
+    ap.add_argument("--focus", type=point, help="X,Y,Z: the point the camera looks at (default the middle of the particles)")
     ap.add_argument("--clip", choices=["x", "y", "z"],
                     help="show only the particles below the middle of the particles' first frame along this axis "
                          "(a cut through the interior, e.g. the bullet's path in the sponge; spheres only)")
@@ -67,7 +161,7 @@ def field_values(particles, field):
         b = particles["left_cauchy_green_elastic"][...]
         return np.linalg.det(b) if len(b) else np.zeros(0)
     if field not in particles:
-        sys.exit(f"render: no particle field '{field}' (fields: det_b_elastic, none, {', '.join(particles.keys())})")
+        fail(f"--field: no particle field '{field}' (fields: det_b_elastic, none, {', '.join(particles.keys())})")
     v = particles[field][...].astype(np.float64)
     return np.linalg.norm(v.reshape(len(v), -1), axis=1) if v.ndim > 1 else v
 
@@ -125,9 +219,12 @@ def producer(data):
 
 
 def select_frames(args):
-    files = sorted(glob.glob(os.path.join(args.output_dir, "frame_*.h5")))
+    if not os.path.isdir(args.output_dir):
+        fail(f"{args.output_dir}: no such directory")
+    files = sorted(f for f in glob.glob(os.path.join(args.output_dir, "frame_*.h5"))
+                   if re.search(r"frame_(\d+)\.h5$", f))
     if not files:
-        sys.exit(f"render: {args.output_dir}: no frame_NNNNN.h5 files")
+        fail(f"{args.output_dir}: no frame_NNNNN.h5 files")
     numbered = {int(re.search(r"frame_(\d+)\.h5$", f).group(1)): f for f in files}
     frames = sorted(numbered)
     if args.frames == "last":
@@ -136,7 +233,7 @@ def select_frames(args):
         wanted = {int(f) for f in args.frames.split(",")}
         frames = [f for f in frames if f in wanted]
         if not frames:
-            sys.exit(f"render: {args.output_dir}: none of the frames {args.frames}")
+            fail(f"--frames: {args.output_dir} has none of the frames {args.frames}")
     return numbered, frames
 
 
@@ -149,7 +246,7 @@ def scan(args, numbered, frames, kept):
     (2nd to 98th percentile in each direction, so that a few strays do not move the camera)."""
     lo_hi, lows, highs, volume, deviations = [math.inf, -math.inf], [], [], [], []
     for f in frames:
-        with h5py.File(numbered[f], "r") as h5:
+        with Frame(numbered[f], args.field) as h5:
             p = h5["particles"]
             if p["position"].shape[0] == 0:
                 continue
@@ -164,7 +261,7 @@ def scan(args, numbered, frames, kept):
             deviations.append(np.percentile(np.abs(values - 1.0), 95))
             volume.append(np.median(p["volume0"][...]))
     if not volume:
-        sys.exit("render: the frames hold no particles")
+        fail(f"{args.output_dir}: the frames hold no particles")
     if args.range:
         lo, hi = args.range
     elif args.field == "det_b_elastic":
@@ -192,7 +289,7 @@ def place_camera(view, args, spacing, bounds_lo, bounds_hi):
     called after the frame is shown, since showing the first object resets the camera."""
     centre = 0.5 * (bounds_lo + bounds_hi)
     if args.focus:
-        centre = np.array([float(v) for v in args.focus.split(",")])
+        centre = np.array(args.focus)
     extent = max(float(np.max(bounds_hi - bounds_lo)), 20 * spacing)
     direction = np.array({"iso": (0.7, 0.45, 1.0), "x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 1e-3), "z": (0.0, 0.0, 1.0)}[args.view])
     direction /= np.linalg.norm(direction)
@@ -271,7 +368,7 @@ def show_material(style, output_dir, frame, particles, args, view, spacing, lut,
 
 
 def render_frame(args, numbered, frame, style, view, kept, spacing, lut, lo_hi, bounds, out_dir, size):
-    with h5py.File(numbered[frame], "r") as h5:
+    with Frame(numbered[frame], args.field) as h5:
         p = h5["particles"]
         x = p["position"][...]
         particles = producer(points_polydata(x[kept(x)], field_values(p, args.field)[kept(x)], args.field))
@@ -305,20 +402,20 @@ def render_frame(args, numbered, frame, style, view, kept, spacing, lut, lo_hi, 
 
 def main():
     args = parse()
-    width, height = (int(v) for v in args.size.lower().split("x"))
+    width, height = args.size
     numbered, frames = select_frames(args)
     style = args.style
     if style == "auto":
         style = "surface" if any(os.path.exists(surface_file(args.output_dir, f)) for f in frames) else "spheres"
     if style == "surface" and not any(os.path.exists(surface_file(args.output_dir, f)) for f in frames):
-        sys.exit(f"render: {args.output_dir}: no surface_NNNNN.obj (run with Output/Surface voxel size > 0)")
+        fail(f"{args.output_dir}: no surface_NNNNN.obj (run with Output/Surface voxel size > 0)")
     out_dir = os.path.join(args.output_dir, "render")
     os.makedirs(out_dir, exist_ok=True)
 
     axis = {"x": 0, "y": 1, "z": 2}.get(args.clip)
     cut = None
     if axis is not None:
-        with h5py.File(numbered[frames[0]], "r") as h5:
+        with Frame(numbered[frames[0]]) as h5:
             x = h5["particles/position"][...]
             cut = 0.5 * (x[:, axis].min() + x[:, axis].max()) if len(x) else 0.0
 
@@ -340,4 +437,11 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except (OSError, KeyError, ValueError, TypeError, IndexError, AttributeError) as e:
+        if reading is None:
+            raise
+        # h5py's messages name HDF5's view of the damage ("truncated file: eof = ..."); one line.
+        reason = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
+        fail(f"{reading}: cannot read the frame ({' '.join(str(reason).split())})")

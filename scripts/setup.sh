@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
 # Installs what is missing (Debian packages), configures and builds viscompm into build/.
 # Sourced by scripts/demo.sh and scripts/test.sh; safe to run again when everything is there.
+# It takes no arguments; VISCOMPM_JOBS (a positive whole number) and VISCOMPM_BUILD_DIR (a
+# directory it can make) are checked first: a bad one is one line on stderr naming it, exit 2.
 set -euo pipefail
 
 VISCOMPM_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${VISCOMPM_BUILD_DIR:-$VISCOMPM_ROOT/build}"
 JOBS="${VISCOMPM_JOBS:-$(nproc)}"
+setup_fail() { echo "setup.sh: $*" >&2; exit 2; }
+# Sourced, "$@" are the caller's arguments: only a script run by itself has none to take.
+if [ "${BASH_SOURCE[0]}" = "$0" ] && [ $# -gt 0 ]; then setup_fail "takes no arguments, got '$1'"; fi
+[[ "$JOBS" =~ ^[1-9][0-9]{0,3}$ ]] || setup_fail "VISCOMPM_JOBS='$JOBS' is not a positive whole number"
+mkdir -p "$BUILD_DIR" 2>/dev/null || setup_fail "VISCOMPM_BUILD_DIR: cannot make the directory $BUILD_DIR"
+[ -w "$BUILD_DIR" ] || setup_fail "VISCOMPM_BUILD_DIR: cannot write to $BUILD_DIR"
 
 packages=(
   cmake g++ make ccache

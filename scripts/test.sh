@@ -8,14 +8,26 @@
 #                                       of MPI and Trilinos suppressed (scripts/sanitizers/)
 #   scripts/test.sh --no-trilinos       only the tests of the physics layer (label no_trilinos),
 #                                       building only them (with --sanitize: 10 min from cold)
+#
+# An option that is neither test.sh's nor ctest's (a typo such as --sanitise) is one line on
+# stderr naming it, exit 2, before anything is built.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ctest_args=()
 sanitize=0
+ctest_help=""
 for argument in "$@"; do
   case "$argument" in
     --sanitize) sanitize=1 ;;
     --no-trilinos) export VISCOMPM_BUILD_TARGET=no_trilinos_tests; ctest_args+=(-L no_trilinos) ;;
+    -*)
+      # ctest's options as its --help lists them ("-j2" is -j, "--timeout=5" is --timeout).
+      [ -n "$ctest_help" ] || ctest_help="$(ctest --help 2>/dev/null || true)"
+      option="${argument%%=*}"
+      [[ "$option" == --* ]] || option="${option:0:2}"
+      grep -q -e "^ *${option}[ ,<=]" -e "^ *${option}\$" -e ", *${option}[ ,<=]" <<< "$ctest_help" ||
+        { echo "test.sh: unknown option '$argument' (test.sh's: --sanitize, --no-trilinos; the rest go to ctest)" >&2; exit 2; }
+      ctest_args+=("$argument") ;;
     *) ctest_args+=("$argument") ;;
   esac
 done

@@ -32,6 +32,12 @@ double Communicator::max(double local) const {
   return global;
 }
 
+std::vector<std::int64_t> Communicator::max(const std::vector<std::int64_t>& local) const {
+  std::vector<std::int64_t> global(local.size(), 0);
+  MPI_Allreduce(local.data(), global.data(), static_cast<int>(local.size()), MPI_INT64_T, MPI_MAX, comm_);
+  return global;
+}
+
 double Communicator::min(double local) const {
   double global = 0.0;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MIN, comm_);

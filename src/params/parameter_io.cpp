@@ -2,13 +2,15 @@
 
 #include <Teuchos_Array.hpp>
 #include <Teuchos_StandardParameterEntryValidators.hpp>
-#include <Teuchos_FileInputSource.hpp>
+#include <Teuchos_StringInputSource.hpp>
 #include <Teuchos_XMLParameterListHelpers.hpp>
 #include <Teuchos_XMLParameterListReader.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <string>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
@@ -330,11 +332,105 @@ bool find_bad_parameter(const Teuchos::XMLObject& xml, const std::string& path, 
 }
 }  // namespace
 
+namespace {
+std::size_t line_at(const std::string& text, std::size_t position) {
+  return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(position), '\n'));
+}
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+}  // namespace
+
+void check_xml_limits(const std::string& text, const std::string& origin) {
+  using L = XmlLimits;
+  if (text.size() > L::max_bytes)
+    throw InputError(origin + ": larger than the " + std::to_string(L::max_bytes >> 20) +
+                     " MiB an XML parameter file may have");
+  const std::size_t n = text.size();
+  auto too_long = [&](std::size_t start, std::size_t length, const char* what) {
+    if (length > L::max_name_length)
+      throw InputError(origin + ": line " + std::to_string(line_at(text, start)) + ": " + what + " of " +
+                       std::to_string(length) + " characters, more than the " + std::to_string(L::max_name_length) +
+                       " an XML parameter file allows");
+  };
+  // Skips to just after `end` from `from`; n if it never comes (Teuchos then names the damage).
+  auto after = [&](std::size_t from, const char* end) {
+    const std::size_t at = text.find(end, from);
+    return at == std::string::npos ? n : at + std::char_traits<char>::length(end);
+  };
+  int depth = 0;
+  std::size_t i = 0;
+  while (i < n) {
+    if (text[i] != '<') {
+      ++i;
+      continue;
+    }
+    const std::size_t start = i;
+    if (text.compare(i, 4, "<!--") == 0) {
+      i = after(i + 4, "-->");
+    } else if (text.compare(i, 9, "<![CDATA[") == 0) {
+      i = after(i + 9, "]]>");
+    } else if (text.compare(i, 2, "<?") == 0) {
+      i = after(i + 2, "?>");
+    } else if (text.compare(i, 2, "<!") == 0) {
+      i = after(i + 2, ">");
+    } else if (text.compare(i, 2, "</") == 0) {
+      if (depth > 0) --depth;
+      i = after(i + 2, ">");
+    } else {
+      // An element's start: its tag, then attributes until "/>" (empty) or ">" (one level down).
+      i += 1;
+      const std::size_t tag = i;
+      while (i < n && !is_space(text[i]) && text[i] != '>' && text[i] != '/') ++i;
+      too_long(start, i - tag, "an element name");
+      bool empty = false;
+      while (i < n) {
+        while (i < n && is_space(text[i])) ++i;
+        if (i >= n) break;
+        if (text[i] == '>') break;
+        if (text[i] == '/') {
+          empty = true;
+          ++i;
+          continue;
+        }
+        const std::size_t name = i;
+        while (i < n && !is_space(text[i]) && text[i] != '=' && text[i] != '>' && text[i] != '/') ++i;
+        too_long(name, i - name, "an attribute name");
+        const bool is_name = text.compare(name, i - name, "name") == 0;
+        while (i < n && is_space(text[i])) ++i;
+        if (i >= n || text[i] != '=') continue;
+        ++i;
+        while (i < n && is_space(text[i])) ++i;
+        if (i >= n || (text[i] != '"' && text[i] != '\'')) continue;
+        const char quote = text[i++];
+        const std::size_t value = i;
+        while (i < n && text[i] != quote) ++i;
+        if (is_name) too_long(value, i - value, "a name");
+        if (i < n) ++i;
+        empty = false;  // a '/' before an attribute was no "/>"
+      }
+      if (i < n) ++i;  // the '>'
+      if (!empty && ++depth > L::max_depth)
+        throw InputError(origin + ": line " + std::to_string(line_at(text, start)) + ": nested more than " +
+                         std::to_string(L::max_depth) + " levels deep, more than an XML parameter file may be");
+    }
+  }
+}
+
 Teuchos::RCP<Teuchos::ParameterList> read_xml_file(const std::string& file) {
-  if (!std::ifstream(file).good()) throw InputError(file + ": cannot open file");
+  // Read once, at most one byte beyond the limit (a device or a FIFO is not read to its end), and
+  // checked before Teuchos sees it.
+  std::error_code error;
+  if (std::filesystem::is_directory(file, error)) throw InputError(file + ": is a directory, not a file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in.good()) throw InputError(file + ": cannot open file");
+  std::string text(XmlLimits::max_bytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) throw InputError(file + ": cannot read file");
+  check_xml_limits(text, file);
   Teuchos::XMLObject xml;
   try {
-    xml = Teuchos::FileInputSource(file).getObject();
+    xml = Teuchos::StringInputSource(text).getObject();
   } catch (const std::exception& e) {
     throw InputError(file + ": not a valid XML file (" + teuchos_reason(e.what()) + ")");
   }

@@ -120,7 +120,10 @@ CommandLine parse_command_line(int argc, const char* const* argv, const ProgramO
   // The scene resolves Solver/File relative to itself; --solver is relative to where we are.
   if (!solver.empty()) add("Solver/File", std::filesystem::absolute(solver).string(), "--solver");
   check_set_once(cl.overrides, sources);
-  cl.restart_file = restart;
+  if (raw.given.count("--restart")) {
+    if (restart.empty()) throw InputError("command line: option --restart: needs a checkpoint file");
+    cl.restart_file = restart;
+  }
   return cl;
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
@@ -589,6 +590,42 @@ namespace {
 constexpr double max_grid_nodes = 9007199254740992.0;
 // Cell indices per dimension are ints.
 constexpr double max_cells_per_dimension = 1073741824.0;
+// The stiffness of a step next to its inertia: beyond 1/ε (ε the double precision) the particles'
+// mass is lost in the round-off of the Hessian, at every Δt the scene allows.
+constexpr double max_stiffness_ratio = 1.0 / std::numeric_limits<double>::epsilon();
+
+// Physical bounds that no allowed Δt can resolve (issue 24), each naming its parameter:
+// - gravity: in the smallest step gravity alone brings a particle at rest to g·Δt_min, and the
+//   CFL condition on that speed asks for Δt ≤ CFL·Δx / (g·Δt_min): beyond g = CFL·Δx / Δt_min² no
+//   step can be taken;
+// - elasticity: a material's P-wave modulus λ + 2μ against its inertia in one step,
+//   (λ + 2μ)·Δt² / (ρ·Δx²) = (c·Δt/Δx)², beyond max_stiffness_ratio at Δt = Min time step.
+void check_physical_bounds(const SceneConfig& scene) {
+  const double dx = scene.grid.cell_size, dt = scene.simulation.min_time_step;
+  const double g = scene.simulation.gravity.norm();
+  const double g_max = scene.simulation.cfl * dx / (dt * dt);
+  if (!(g <= g_max)) {
+    std::ostringstream reason;
+    reason.precision(3);
+    reason << "a gravity of " << g << " m/s^2 moves a particle at rest by more than CFL·Δx in Simulation/Min time step ("
+           << dt << " s): no step can be taken above CFL·Δx/Δt_min² = " << g_max << " m/s^2";
+    throw parameter_error(scene.file, "Simulation/Gravity", reason.str());
+  }
+  for (const auto& m : scene.materials) {
+    if (!m.entry || !m.values.has("Density") || !m.values.has("Lame lambda") || !m.values.has("Shear modulus")) continue;
+    const double density = m.values.real("Density"), mu = m.values.real("Shear modulus"),
+                 lambda = m.values.real("Lame lambda");
+    const double ratio = (lambda + 2.0 * mu) * dt * dt / (density * dx * dx);
+    if (ratio <= max_stiffness_ratio) continue;
+    std::ostringstream reason;
+    reason.precision(3);
+    reason << "(λ + 2μ)·Δt²/(ρ·Δx²) = " << ratio << " at Simulation/Min time step (" << dt
+           << " s): the material's stiffness exceeds its inertia in a step by more than double precision holds ("
+           << max_stiffness_ratio << "), at every Δt the scene allows";
+    throw parameter_error(scene.file, "Materials/" + m.name + (lambda > 2.0 * mu ? "/Lame lambda" : "/Shear modulus"),
+                          reason.str());
+  }
+}
 
 void check_grid_and_time_steps(const SceneConfig& scene) {
   const std::string& file = scene.file;
@@ -761,6 +798,7 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   for (const auto& s : sections()) read_section(*root, s, reading);
   link_names(scene);
   check_grid_and_time_steps(scene);
+  check_physical_bounds(scene);
   check_settings(scene);
   derive_from_cell_size(scene);  // meshes: the only part of reading that may take long
   check_shapes_and_speeds(scene);

@@ -247,7 +247,7 @@ void restore(const std::string& restart_file, const grid::GridGeometry& grid, gr
 
 SimulationState initial_state(const scene::SceneConfig& scene, const grid::GridGeometry& grid, grid::KernelOrder order,
                               const materials::MaterialList& materials, const boundary::Boundary& boundary,
-                              const parallel::Communicator& comm, const std::string& restart_file) {
+                              const parallel::Communicator& comm, const std::optional<std::string>& restart_file) {
   SimulationState state;
   state.time_step_cap = scene.simulation.max_time_step;
   try {
@@ -255,15 +255,15 @@ SimulationState initial_state(const scene::SceneConfig& scene, const grid::GridG
   } catch (const InputError& e) {
     throw parameter_error(scene.file, "Grid/Cell size", e.what());
   }
-  if (restart_file.empty()) check_memory(scene, comm);  // before any layer or body is laid out
+  if (!restart_file) check_memory(scene, comm);  // before any layer or body is laid out
   state.emitters = make_emitters(scene, grid, materials);
-  if (restart_file.empty()) {
+  if (!restart_file) {
     state.particles = sample_particles(scene, grid, order, *state.decomposition, materials, comm.rank());
     for (auto& emitter : state.emitters)
       emitter.emit(0.0, [&](const Vec3& x) { return parallel::particle_owner(*state.decomposition, grid, order, x) == comm.rank(); },
                    state.particles);
   } else {
-    restore(restart_file, grid, order, materials, comm, state);
+    restore(*restart_file, grid, order, materials, comm, state);
   }
   if (comm.sum(static_cast<std::int64_t>(state.particles.size())) == 0)
     throw parameter_error(scene.file, "Bodies", "no particle falls inside the grid");

@@ -32,12 +32,12 @@ materials::MaterialList one_per_scene_material(materials::MaterialList materials
 }  // namespace
 
 Simulation::Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
-                       const parallel::Communicator& comm, const std::string& restart_file)
+                       const parallel::Communicator& comm, const std::optional<std::string>& restart_file)
     : Simulation(scene, make_materials(scene), solver, comm, restart_file) {}
 
 Simulation::Simulation(const scene::SceneConfig& scene, materials::MaterialList materials,
                        const linalg::SolverConfiguration& solver, const parallel::Communicator& comm,
-                       const std::string& restart_file)
+                       const std::optional<std::string>& restart_file)
     : scene_(linked(scene)),
       comm_(comm),
       geometry_(make_grid(scene_.grid)),
@@ -46,31 +46,45 @@ Simulation::Simulation(const scene::SceneConfig& scene, materials::MaterialList 
       state_(initial_state(scene_, geometry_, scene_.simulation.kernel, materials_, boundary_, comm_, restart_file)),
       stepper_(scene_, state_, geometry_, scene_.simulation.kernel, materials_, boundary_, solver, comm_) {}
 
-bool Simulation::stop_requested(RunSummary& summary, std::ostream* log) {
-  // One agreement per step: a signal may reach only some ranks, the clocks differ, and only
-  // rank 0 writes solver.csv.
+RunControl RunControl::agreed(const RunControl& local, const parallel::Communicator& comm) {
+  const std::vector<std::int64_t> all = comm.max(std::vector<std::int64_t>{
+      local.stop_signal, local.checkpoint_due ? 1 : 0, local.solver_log_failed ? 1 : 0});
+  RunControl agreed;
+  agreed.stop_signal = static_cast<int>(all[0]);
+  agreed.checkpoint_due = all[1] != 0;
+  agreed.solver_log_failed = all[2] != 0;
+  return agreed;
+}
+
+RunControl Simulation::local_control() const {
+  RunControl local;
+  local.stop_signal = stop_signal();
   const double wall = scene_.output.checkpoint_wall_seconds;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_time_).count();
-  double flags[3] = {static_cast<double>(stop_signal()), wall > 0.0 && elapsed >= wall ? 1.0 : 0.0,
-                     solver_log_ && !solver_log_->good() ? 1.0 : 0.0};
-  MPI_Allreduce(MPI_IN_PLACE, flags, 3, MPI_DOUBLE, MPI_MAX, comm_.comm());
-  if (flags[2] > 0.0)
+  local.checkpoint_due =
+      wall > 0.0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_time_).count() >= wall;
+  local.solver_log_failed = solver_log_ && !solver_log_->good();
+  return local;
+}
+
+bool Simulation::stop_requested(RunSummary& summary, std::ostream* log) {
+  const RunControl control = RunControl::agreed(local_control(), comm_);
+  if (control.solver_log_failed)
     throw SimulationError("cannot write " + solver_log_->path() + ": " + io::write_failure_reason(solver_log_->path()));
-  if (flags[0] == 0.0 && flags[1] == 0.0) return false;
+  if (!control.stop() && !control.checkpoint_due) return false;
   // A checkpoint between frames, replacing the one this run wrote before.
-  const std::string previous = wall_checkpoint_;
+  const std::optional<std::string> previous = wall_checkpoint_;
   wall_checkpoint_ = write_checkpoint_file(io::step_checkpoint_file_name(state_.step));
   last_checkpoint_time_ = std::chrono::steady_clock::now();
-  if (comm_.is_root() && !previous.empty() && previous != wall_checkpoint_) {
+  if (comm_.is_root() && previous && *previous != *wall_checkpoint_) {
     std::error_code ignored;
-    std::filesystem::remove(previous, ignored);
+    std::filesystem::remove(*previous, ignored);
   }
-  if (flags[0] == 0.0) {
-    if (log && comm_.is_root()) *log << "  step " << state_.step << ": checkpoint " << wall_checkpoint_ << "\n";
+  if (!control.stop()) {
+    if (log && comm_.is_root()) *log << "  step " << state_.step << ": checkpoint " << *wall_checkpoint_ << "\n";
     return false;
   }
-  summary.stop_signal = static_cast<int>(flags[0]);
-  summary.stop_checkpoint = wall_checkpoint_;
+  summary.stop_signal = control.stop_signal;
+  summary.stop_checkpoint = *wall_checkpoint_;
   return true;
 }
 

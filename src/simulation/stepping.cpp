@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
+#include <string>
 #include <ostream>
 
 #include "viscompm/core/error.hpp"
@@ -99,7 +101,12 @@ bool Stepper::advance_to(double t_end, RunSummary& summary, std::ostream* log, c
     const double remaining = t_end - state_.time;
     if (dt >= remaining * (1.0 - landing_tolerance)) dt = remaining;
     else if (dt > sliver_fraction * remaining) dt = sliver_fraction * remaining;
-    take_step(dt, summary, log);  // abandoned (time and step unchanged) on a stop request
+    if (take_step(dt, summary, log) == StepOutcome::interrupted) {
+      // Abandoned (time and step unchanged): the caller agrees on the stop, and the step is not
+      // tried again here (with an interrupt that stays set, it never would be taken).
+      if (after_step) after_step();
+      return false;
+    }
     // The layers due by the end of the step, before a frame can be written (doc/scenes.md).
     emit_particles();
     if (after_step && after_step()) return false;
@@ -131,8 +138,8 @@ void Stepper::record_attempt(const StepReport& report, RunSummary& summary) {
   summary.owned_node_steps += comm_.sum(static_cast<std::int64_t>(report.owned_nodes));
 }
 
-void Stepper::take_step(double dt, RunSummary& summary, std::ostream* log) {
-  std::string dump_prefix;
+StepOutcome Stepper::take_step(double dt, RunSummary& summary, std::ostream* log) {
+  std::optional<std::string> dump_prefix;
   for (double s : scene_.output.matrix_market_steps)
     if (static_cast<std::int64_t>(s) == state_.step + 1)
       dump_prefix = scene_.output.directory + "/newton_step_" + std::to_string(state_.step + 1);
@@ -140,7 +147,7 @@ void Stepper::take_step(double dt, RunSummary& summary, std::ostream* log) {
     // A step that is not taken leaves the particles as they were (TimeIntegrator::step).
     const StepReport report = integrator_->step(state_.particles, state_.time, dt, dump_prefix);
     record_attempt(report, summary);
-    if (report.newton.interrupted) return;  // a stop request: the state stays that of the step's start
+    if (report.newton.interrupted) return StepOutcome::interrupted;  // the state stays that of the step's start
     if (report.taken) break;
     ++summary.retries;
     const double reduction = scene_.simulation.time_step_reduction;
@@ -158,6 +165,7 @@ void Stepper::take_step(double dt, RunSummary& summary, std::ostream* log) {
   ++state_.step;
   ++summary.steps;
   state_.time_step_cap = std::min(scene_.simulation.time_step_growth * state_.time_step_cap, scene_.simulation.max_time_step);
+  return StepOutcome::taken;
 }
 
 }  // namespace viscompm::simulation

@@ -33,7 +33,7 @@ TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::G
 }
 
 StepReport TimeIntegrator::step(particles::ParticleSet& own_particles, double t, double dt,
-                                 const std::string& dump_prefix) {
+                                 const std::optional<std::string>& dump_prefix) {
   static const auto layout_timer = timer("viscompm: 1 layout");
   static const auto p2g_timer = timer("viscompm: 2 p2g");
   static const auto newton_timer = timer("viscompm: 3 newton");
@@ -59,9 +59,9 @@ StepReport TimeIntegrator::step(particles::ParticleSet& own_particles, double t,
   {
     Teuchos::TimeMonitor m(*newton_timer);
     newton::SystemObserver dump;
-    if (!dump_prefix.empty())
+    if (dump_prefix)
       dump = [&](int iteration, const linalg::NewtonSystem& system, const NodeVectorField& rhs) {
-        if (iteration == 1) system.write_matrix_market(dump_prefix, rhs);
+        if (iteration == 1) system.write_matrix_market(*dump_prefix, rhs);
       };
     report.newton = newton_.solve(*objective->potential, v, dump);
   }

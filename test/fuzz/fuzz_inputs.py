@@ -15,6 +15,8 @@ viscompm-study):
   study    viscompm-study on a small study whose file, scene, solver or MatrixMarket files (matrix,
            right-hand side, coordinates) are cut short or corrupted (class 5)
   options  options repeated or malformed on the command line (class 6)
+  parser   a scene, solver or study file nested deeper, named longer or grown larger than the XML
+           reader's bounds (or nested up to them with unknown sections): exit 2 (issue 24)
 
 Every run must end with exit 0, 2 or 3 within its time limit, exit 2 and 3 with one line on stderr,
 no crash, no hang, no "internal error", every frame it wrote finite, and exit 2 within seconds. The
@@ -499,7 +501,53 @@ def study_variant(v, rng):
     v.command = [args.study, v.write("study.xml", study), "--output", v.out]
 
 
-FAMILIES = {"scene": 36, "solver": 16, "list": 8, "mesh": 9, "size": 8, "motion": 8, "study": 8, "options": 7}
+def parser_variant(v, rng):
+    """A file beyond (or, with unknown sections, at) the XML reader's bounds: 32 levels, 256
+    characters per name, 4 MiB. Every such file is bad input: exit 2 within seconds."""
+    role = rng.choice(["scene", "solver", "study"] if args.study else ["scene", "solver"])
+    kind = rng.choice(["deep", "deep", "at_depth", "long_name", "long_tag", "large", "large_sparse"])
+    text = absolute_files(open(sponge).read(), sponge)
+    if kind in ("deep", "at_depth"):
+        depth = rng.randint(33, 20000) if kind == "deep" else rng.randint(2, 31)
+        inner = "".join(f'<ParameterList name="n{i}">' for i in range(depth)) + "</ParameterList>" * depth
+        text = text.replace("<ParameterList name=\"Output\">", inner + "<ParameterList name=\"Output\">", 1)
+        v.mutations.append(f"{depth} nested lists")
+    elif kind in ("long_name", "long_tag"):
+        length = rng.choice([257, 1000, 100000, 3000000])
+        name = "".join(rng.choice("abcdefgh ") for _ in range(min(length, 64))) * (length // 64 + 1)
+        name = name[:length]
+        text = (text.replace('name="Output"', f'name="{name}"', 1) if kind == "long_name"
+                else text.replace("<Parameter ", f"<P{name.replace(' ', 'x')} ", 1))
+        v.mutations.append(f"a{' tag' if kind == 'long_tag' else ''} name of {length} characters")
+    path = os.path.join(v.work, f"{role}.xml")
+    if role == "solver":
+        text = text if kind not in ("deep", "at_depth") else open(os.path.join(inputs, "solvers", "jacobi_cg.xml")).read().replace(
+            "</ParameterList>", inner + "</ParameterList>", 1)
+    if role == "study" and kind in ("deep", "at_depth"):
+        text = ('<ParameterList name="fuzzed"><Parameter name="Scene" type="string" value="' + sponge + '"/>' +
+                inner + "</ParameterList>")
+    with open(path, "w") as f:
+        f.write(text)
+    if kind == "large":
+        with open(path, "a") as f:
+            f.write("<!--" + "x" * rng.randint(4 << 20, 6 << 20) + "-->")
+        v.mutations.append("grown beyond 4 MiB by a comment")
+    elif kind == "large_sparse":
+        os.truncate(path, rng.choice([(4 << 20) + 1, 1 << 30, 1 << 34]))  # holes: no disk space
+        v.mutations.append(f"{os.path.getsize(path)} bytes, mostly holes")
+    v.mutations[-1] += f" in the {role} file"
+    v.expect = {2}
+    if role == "scene":
+        v.simulate(path)
+    elif role == "solver":
+        v.simulate(sponge, "--solver", path, *coarse)
+    else:
+        v.sentinels = ["study.csv", "operators.csv", "steps.csv"]
+        v.command = [args.study, path, "--output", v.out]
+
+
+FAMILIES = {"scene": 36, "solver": 16, "list": 8, "mesh": 9, "size": 8, "motion": 8, "study": 8, "options": 7,
+            "parser": 4}
 
 
 def make_variant(index):
@@ -510,7 +558,7 @@ def make_variant(index):
     {"scene": lambda: scene_variant(v, rng, True), "solver": lambda: scene_variant(v, rng, False),
      "list": lambda: list_variant(v, rng), "mesh": lambda: mesh_variant(v, rng), "size": lambda: size_variant(v, rng),
      "motion": lambda: motion_variant(v, rng), "study": lambda: study_variant(v, rng),
-     "options": lambda: options_variant(v, rng)}[family]()
+     "options": lambda: options_variant(v, rng), "parser": lambda: parser_variant(v, rng)}[family]()
     # Files an earlier run left in the output directory (a frame that reads back as finite).
     os.makedirs(v.out, exist_ok=True)
     for name in v.sentinels:

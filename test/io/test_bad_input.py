@@ -3,7 +3,8 @@
 exit 2 within seconds, one line on stderr naming the file and the parameter (or the option), and
 every file an earlier run left in the output directory as it was. One case per kind of defect:
 non-finite items of lists (class 1), non-finite mesh vertices (2), voxels OpenVDB or the memory
-cannot take (3), emitters and motions at their limits (4), repeated or malformed options (6).
+cannot take (3), emitters and motions at their limits (4), repeated or malformed options (6), and
+XML files beyond the reader's bounds (issue 24: depth, name length, size).
 viscompm-study's inputs (class 5) are checked by test/study/test_study_cli.py."""
 import os
 import re
@@ -59,6 +60,22 @@ def mesh_entries(mesh, extra=""):
             f'<Parameter name="Center" type="Array(double)" value="{{0.5, 0.5, 0.3}}"/>{extra}')
 
 
+def deep_file(name, depth):
+    """`depth` ParameterLists one inside the other: 10 000 used to crash Teuchos' parser."""
+    path = os.path.join(args.workdir, name)
+    with open(path, "w") as f:
+        f.write("".join(f'<ParameterList name="l{i}">\n' for i in range(depth)) + "</ParameterList>\n" * depth)
+    return path
+
+
+def huge_file(name):
+    """The default scene with a 5 MiB comment: beyond the 4 MiB an XML parameter file may have."""
+    path = os.path.join(args.workdir, name)
+    with open(path, "w") as f:
+        f.write(open(sponge).read().replace("<ParameterList", "<!--" + " " * (5 << 20) + "--><ParameterList", 1))
+    return path
+
+
 bullet_velocity = '<Parameter name="Velocity" type="Array(double)" value="{4, 0, 0}"/>'
 colliders = '<ParameterList name="Colliders">'
 bodies = '<ParameterList name="Bodies">'
@@ -106,6 +123,20 @@ cases = [
      sponge, "'Colliders/bullet/Stop time'"),
     ("an angular velocity no time step can follow", [sponge, *coarse, "--set", "Colliders/bullet/Angular velocity={0,0,1e8}"],
      sponge, "'Colliders/bullet/Angular velocity'"),
+    ("a scene nested 10 000 levels deep", [deep_file("deep_scene.xml", 10000)], "deep_scene.xml",
+     "nested more than 32 levels"),
+    ("a solver file nested 10 000 levels deep", [sponge, "--solver", deep_file("deep_solver.xml", 10000)],
+     "deep_solver.xml", "nested more than 32 levels"),
+    ("a scene with a name of 100 000 characters",
+     [scene_variant("long_name", sponge, [('<ParameterList name="Output">', '<ParameterList name="' + "O" * 100000 + '">')])],
+     "long_name.xml", "a name of 100000 characters, more than the 256"),
+    ("a 5 MiB scene", [huge_file("huge_scene.xml")], "huge_scene.xml", "larger than the 4 MiB"),
+    ("a gravity no Min time step can follow", [sponge, *coarse, "--set", "Simulation/Gravity={0, -1e300, 0}"],
+     sponge, "'Simulation/Gravity'"),
+    ("a Lame lambda whose step holds no inertia", [sponge, *coarse, "--set", "Materials/sponge/Lame lambda=1e300"],
+     sponge, "'Materials/sponge/Lame lambda'"),
+    ("a density below any material's", [sponge, *coarse, "--set", "Materials/sponge/Density=1e-300"],
+     sponge, "'Materials/sponge/Density'"),
     ("--solver twice", [sponge, "--solver", os.path.join(solvers, "jacobi_cg.xml"), "--solver",
                         os.path.join(solvers, "sgs_cg.xml")], "", "--solver"),
     ("--frames that is not a number", [sponge, "--frames", "abc"], "", "--frames"),

@@ -6,6 +6,7 @@
 #include <set>
 #include <tuple>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
@@ -254,6 +255,48 @@ TEST(CommandLine, RepeatedOptionsAndParametersSetTwiceAreRejected) {
     EXPECT_EQ(m.find("Simulation/Frames"), std::string::npos) << m;
   }
   EXPECT_EQ(error({"viscompm", "scene.xml", "--set", "A/B=1", "--set", "C/D=2", "--frames", "0"}), "");
+}
+
+// Issue 24: values in their declared ranges that ended a run at its first step (exit 3, naming no
+// parameter) are bad input when the scene is read, naming the parameter: a gravity no Min time
+// step can follow (beyond CFL·Δx/Δt_min²), a stiffness whose step Hessian holds no inertia in
+// double precision ((λ+2μ)Δt_min²/(ρΔx²) > 1/ε), a density below any material's.
+TEST(Scene, PhysicalBoundsNameTheParameter) {
+  for (const auto& [path, value, reason] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"Simulation/Gravity", "{0, -1e300, 0}", "no step can be taken"},
+           {"Materials/sponge/Lame lambda", "1e300", "more than double precision holds"},
+           {"Materials/sponge/Shear modulus", "1e300", "more than double precision holds"},
+           {"Materials/sponge/Density", "1e-300", "out of range"}}) {
+    const std::string message = read_error(default_scene, {{path, value}});
+    expect_one_line_naming(message, default_scene, path);
+    EXPECT_NE(message.find(reason), std::string::npos) << message;
+  }
+  // The bounds at their edges (Cell size 0.03, Min time step 1e-7, CFL 0.6, density 1).
+  EXPECT_EQ(read_error(default_scene, {{"Simulation/Gravity", "{0, -1.7e12, 0}"}}), "");
+  EXPECT_NE(read_error(default_scene, {{"Simulation/Gravity", "{0, -1.9e12, 0}"}}), "");
+  EXPECT_EQ(read_error(default_scene, {{"Materials/sponge/Lame lambda", "4e26"}}), "");
+  EXPECT_NE(read_error(default_scene, {{"Materials/sponge/Lame lambda", "5e26"}}), "");
+  // Physical extremes still read: steel's stiffness, 100 g, a light foam.
+  EXPECT_EQ(read_error(default_scene, {{"Materials/sponge/Lame lambda", "1e11"}, {"Simulation/Gravity", "{0, -981, 0}"},
+                                       {"Materials/sponge/Density", "0.01"}}),
+            "");
+}
+
+// --restart is an optional value, not an empty-string switch: absent is no restart, given empty is
+// bad input (it used to mean "no restart").
+TEST(CommandLine, RestartIsGivenOrNot) {
+  const scene::ProgramOptions options{"viscompm", "test"};
+  const char* plain[] = {"viscompm", "scene.xml"};
+  EXPECT_FALSE(scene::parse_command_line(2, plain, options).restart_file.has_value());
+  const char* restart[] = {"viscompm", "scene.xml", "--restart", "c.h5"};
+  EXPECT_EQ(scene::parse_command_line(4, restart, options).restart_file, std::optional<std::string>("c.h5"));
+  const char* empty[] = {"viscompm", "scene.xml", "--restart="};
+  try {
+    scene::parse_command_line(3, empty, options);
+    ADD_FAILURE() << "--restart= was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "command line: option --restart: needs a checkpoint file");
+  }
 }
 
 TEST(Scene, AMissingSolverFileNamesTheSceneAndTheParameter) {

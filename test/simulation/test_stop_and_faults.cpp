@@ -8,6 +8,7 @@
 #include <csignal>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 #include "gather.hpp"
 #include "scenes.hpp"
@@ -114,6 +115,58 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   const auto result = testkit::gather_particles(continued.particles(), world.comm());
   EXPECT_TRUE(testkit::bitwise_equal(reference, result)) << "difference " << testkit::max_state_difference(reference, result);
   if (world.is_root()) EXPECT_EQ(files_starting_with(dir + "/stopped", "frame_").size(), 4u);
+}
+
+// The run's control state (stop request, wall-clock checkpoint, solver.csv's health) is agreed by
+// every rank in one collective: what any rank sees, all see; the largest signal wins.
+TEST(RunControl, IsAgreedByEveryRank) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  simulation::RunControl local;
+  EXPECT_FALSE(simulation::RunControl::agreed(local, world).stop());
+  if (world.rank() == world.size() - 1) local.stop_signal = SIGINT;
+  if (world.rank() == 0) local.checkpoint_due = true;
+  simulation::RunControl agreed = simulation::RunControl::agreed(local, world);
+  EXPECT_EQ(agreed.stop_signal, SIGINT);
+  EXPECT_TRUE(agreed.stop());
+  EXPECT_TRUE(agreed.checkpoint_due);
+  EXPECT_FALSE(agreed.solver_log_failed);
+  local = {};
+  local.stop_signal = world.rank() == 0 ? SIGTERM : SIGINT;  // SIGTERM (15) > SIGINT (2)
+  local.solver_log_failed = world.rank() == world.size() - 1;
+  agreed = simulation::RunControl::agreed(local, world);
+  EXPECT_EQ(agreed.stop_signal, SIGTERM);
+  EXPECT_FALSE(agreed.checkpoint_due);
+  EXPECT_TRUE(agreed.solver_log_failed);
+}
+
+// An interrupt installed on the public integrator, without run()'s after-step callback: advance_to
+// returns after the abandoned step (time and step unchanged) instead of trying it for ever; it
+// used to loop, here cut short by an exception after 1000 questions (issue 24).
+TEST(Interrupts, EndAdvanceToWithoutAnAfterStepCallback) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = testkit::work_directory(world, "interrupt_without_after_step");
+  simulation::Simulation sim(short_run(dir), testkit::jacobi_cg(1e-10), world);
+  simulation::RunSummary summary;
+  ASSERT_TRUE(sim.advance_to(0.25 / 120.0, summary));
+  const double t = sim.time();
+  const std::int64_t steps = sim.step_count();
+  ASSERT_GT(steps, 0);
+  int asked = 0;
+  sim.integrator().set_interrupt([&] {
+    if (++asked > 1000) throw std::runtime_error("advance_to asked the interrupt 1000 times");
+    return true;
+  });
+  bool reached = true;
+  EXPECT_NO_THROW(reached = sim.advance_to(1.0 / 120.0, summary));
+  EXPECT_FALSE(reached);
+  EXPECT_EQ(sim.time(), t);
+  EXPECT_EQ(sim.step_count(), steps);
+  EXPECT_EQ(asked, 1) << "one step tried, abandoned at its first Newton iteration";
+  // Without the interrupt the same call goes on to the end.
+  sim.integrator().set_interrupt({});
+  EXPECT_TRUE(sim.advance_to(1.0 / 120.0, summary));
+  EXPECT_EQ(sim.time(), 1.0 / 120.0);
+  EXPECT_GT(sim.step_count(), steps);
 }
 
 TEST(WallClockCheckpoints, EachReplacesThePreviousAndTheRunGoesOn) {

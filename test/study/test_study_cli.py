@@ -194,6 +194,21 @@ for what, sets, named_file, named_parameter in cases:
     check(time.time() - started < 10, f"{what}: answered within seconds ({time.time() - started:.1f} s)")
     check(previous_results(out + "_mm") == before, f"{what}: the earlier study.csv and operators.csv are intact")
 
+# A study file, or a solver file it lists, nested 10 000 levels deep: exit 2 naming the file and the
+# bound (issue 24: Teuchos' parser used to overflow its stack).
+deep = os.path.join(args.workdir, "deep.xml")
+with open(deep, "w") as f:
+    f.write("".join(f'<ParameterList name="l{i}">\n' for i in range(10000)) + "</ParameterList>\n" * 10000)
+for what, command in (("a deep study file", [deep]),
+                      ("a deep solver file", [mm_study, "--set", f"Solvers={{{deep}}}"])):
+    started = time.time()
+    result = run(args.study, *command, "--output", out + "_mm")
+    lines = stderr_lines(result)
+    check(result.returncode == 2 and len(lines) == 1 and deep in lines[0] and "nested more than 32 levels" in lines[0],
+          f"{what}: exit 2 and one line naming {deep} and the bound, got {result.returncode}: {result.stderr[-800:]}")
+    check(time.time() - started < 10, f"{what}: answered within seconds ({time.time() - started:.1f} s)")
+    check(previous_results(out + "_mm") == before, f"{what}: the earlier study.csv and operators.csv are intact")
+
 # The steps mode: two frames of the coarse sponge per configuration, exact and lagged Newton.
 steps_study = os.path.join(args.workdir, "steps.xml")
 with open(steps_study, "w") as f:

@@ -24,8 +24,10 @@ struct ElasticParameters {
 /// ElasticParameters; `energy` names the energy they enter, e.g. "(5.8)".
 template <class P>
 void add_elastic_parameters(ParameterTable<P>& table, const std::string& energy) {
-  table.real(static_cast<double P::*>(&ElasticParameters::density), "Density", 1.0, Range::positive(),
-             "mass density ρ [kg/m^3]")
+  // Below 1e-3 kg/m^3 is no material (hydrogen at room conditions has 0.08, the lightest aerogels
+  // about 0.2): a continuum of particles of such mass is a typo (issue 24).
+  table.real(static_cast<double P::*>(&ElasticParameters::density), "Density", 1.0, Range::at_least(1e-3),
+             "mass density ρ [kg/m^3], at least 1e-3 (below any material's)")
       .real(static_cast<double P::*>(&ElasticParameters::shear_modulus), "Shear modulus", 1.0,
             Range::non_negative(), "Neo-Hookean μ of " + energy + " [Pa]")
       .real(static_cast<double P::*>(&ElasticParameters::lame_lambda), "Lame lambda", 1.0, Range::any(),

@@ -25,6 +25,9 @@ class Communicator {
   double max(double local) const;
   double min(double local) const;
   std::int64_t max(std::int64_t local) const;
+  /// The element-wise maximum over the ranks of equally long vectors, on every rank: several
+  /// decisions agreed in one collective (e.g. a run's stop state after a step).
+  std::vector<std::int64_t> max(const std::vector<std::int64_t>& local) const;
   /// Every rank's values, concatenated in rank order, on every rank.
   std::vector<double> all_gather(const std::vector<double>& local) const;
   std::vector<std::int64_t> all_gather(const std::vector<std::int64_t>& local) const;

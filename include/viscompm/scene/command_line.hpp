@@ -4,6 +4,7 @@
 // "--option value" and "--option=value" are both accepted; --set may repeat.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,7 @@ namespace viscompm::scene {
 
 struct CommandLine {
   std::string input_file;               ///< the scene (or study) XML
-  std::string restart_file;             ///< --restart, empty if not given
+  std::optional<std::string> restart_file;  ///< --restart, if given (never empty)
   std::vector<Override> overrides;      ///< --set, then --output, --frames and --solver as overrides
   bool help = false;
   std::string help_text;                ///< filled when help is true

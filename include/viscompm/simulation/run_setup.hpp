@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,6 @@ IntegratorSettings integrator_settings(const scene::SceneConfig& scene);
 /// particles. InputError if the checkpoint does not fit the scene or no particle lies in the grid.
 SimulationState initial_state(const scene::SceneConfig& scene, const grid::GridGeometry& grid, grid::KernelOrder order,
                               const materials::MaterialList& materials, const boundary::Boundary& boundary,
-                              const parallel::Communicator& comm, const std::string& restart_file);
+                              const parallel::Communicator& comm, const std::optional<std::string>& restart_file);
 
 }  // namespace viscompm::simulation

@@ -9,6 +9,8 @@
 #include <chrono>
 #include <iosfwd>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "viscompm/boundary/colliders.hpp"
 #include "viscompm/io/frame_writer.hpp"
@@ -22,17 +24,29 @@
 
 namespace viscompm::simulation {
 
+/// What the ranks of a run agree on after every step (Simulation::run), in one collective: a
+/// signal may reach only some ranks, their clocks differ, and only rank 0 writes solver.csv.
+struct RunControl {
+  int stop_signal = 0;             ///< the signal of a stop request (stop_request.hpp); 0: none
+  bool checkpoint_due = false;     ///< Output/Checkpoint wall seconds have passed since the last one
+  bool solver_log_failed = false;  ///< solver.csv could not be written
+  bool stop() const { return stop_signal != 0; }
+  /// The ranks' states combined (collective): the largest signal, a checkpoint due or a failed
+  /// log on any rank.
+  static RunControl agreed(const RunControl& local, const parallel::Communicator& comm);
+};
+
 class Simulation {
  public:
   /// A run of `scene`; with `restart_file`, the state comes from that checkpoint instead of the
   /// scene's bodies (InputError if it does not fit the scene).
   Simulation(const scene::SceneConfig& scene, const linalg::SolverConfiguration& solver,
-             const parallel::Communicator& comm, const std::string& restart_file = "");
+             const parallel::Communicator& comm, const std::optional<std::string>& restart_file = std::nullopt);
   /// The same with the materials built by the caller, one per scene material in the scene's
   /// order (models defined outside the registry: a library user's, or a test's).
   Simulation(const scene::SceneConfig& scene, materials::MaterialList materials,
              const linalg::SolverConfiguration& solver, const parallel::Communicator& comm,
-             const std::string& restart_file = "");
+             const std::optional<std::string>& restart_file = std::nullopt);
   // The stepping holds references to the scene, state and boundary held here.
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -47,7 +61,8 @@ class Simulation {
   /// continues as one restarted from it would (TimeIntegrator::reset_reuse).
   std::string write_checkpoint();
   /// Advances to time t_end with adaptive steps (no output, no stop requests). Throws
-  /// SimulationError if a step fails at the smallest Δt.
+  /// SimulationError if a step fails at the smallest Δt. False if a step was interrupted
+  /// (an interrupt installed on integrator()): the state is that after the last step taken.
   bool advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr) {
     return stepper_.advance_to(t_end, summary, log);
   }
@@ -80,10 +95,12 @@ class Simulation {
   std::unique_ptr<io::SolverLog> solver_log_;  ///< open during run()
   std::vector<io::FrameInfo> frames_;
   std::chrono::steady_clock::time_point last_checkpoint_time_;
-  std::string wall_checkpoint_;  ///< the last checkpoint written between frames by this run
+  std::optional<std::string> wall_checkpoint_;  ///< the last checkpoint written between frames by this run
 
-  /// After a step inside run(): agrees on stop requests, wall-clock checkpoints and the solver
-  /// log's health; true if the run must stop (its checkpoint written).
+  /// This rank's view of the run's control state now (its own signal, clock and log).
+  RunControl local_control() const;
+  /// After a step inside run(): agrees on the RunControl, writes the checkpoint it asks for;
+  /// true if the run must stop (its checkpoint written).
   bool stop_requested(RunSummary& summary, std::ostream* log);
   /// Writes DIR/NAME and resets the integrator's reuse, as write_checkpoint.
   std::string write_checkpoint_file(const std::string& name);

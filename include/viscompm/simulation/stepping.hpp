@@ -4,7 +4,9 @@
 // time), the TimeIntegrator takes the step — retried here with a smaller Δt when it fails (the
 // integrator leaves the particles as they were) — and its statistics are summed; after it, the
 // emitters add the layers due by its end, and the caller's after-step callback decides whether to
-// go on.
+// go on. A step abandoned on the integrator's interrupt (TimeIntegrator::set_interrupt) ends
+// advance_to too, with or without an after-step callback: it cannot loop on a step that is never
+// taken.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +46,10 @@ struct RunSummary {
 /// Called after every step on every rank (collective): true stops advancing.
 using AfterStep = std::function<bool()>;
 
+/// How one step of advance_to ended: taken (perhaps after retries with a smaller Δt), or
+/// abandoned on the integrator's interrupt (the state is that of the step's start).
+enum class StepOutcome { taken, interrupted };
+
 class Stepper {
  public:
   /// Steps `state` (which must outlive the stepper) with the scene's step control.
@@ -54,7 +60,9 @@ class Stepper {
   Stepper& operator=(const Stepper&) = delete;
 
   /// Advances to time t_end. Throws SimulationError if a step fails at the smallest Δt. Returns
-  /// false when `after_step` asked to stop (the state is then that after the last step taken).
+  /// false when `after_step` asked to stop or a step was interrupted (TimeIntegrator::set_interrupt;
+  /// `after_step` is still called, so that the ranks can agree on the stop and checkpoint): the
+  /// state is then that after the last step taken. It never retries an interrupted step.
   bool advance_to(double t_end, RunSummary& summary, std::ostream* log = nullptr, const AfterStep& after_step = {});
   /// The Δt the next step would try (CFL, bounds), before landing on the target time.
   double suggested_time_step() const;
@@ -80,7 +88,7 @@ class Stepper {
   /// threshold) and migrates the particles (collective).
   void rebalance_if_needed(RunSummary& summary, std::ostream* log);
   /// One step of length dt, retried with smaller Δt until it is taken (or interrupted).
-  void take_step(double dt, RunSummary& summary, std::ostream* log);
+  StepOutcome take_step(double dt, RunSummary& summary, std::ostream* log);
   /// Adds an attempt's counts (Newton, CG, timings) to the summary and solver.csv.
   void record_attempt(const StepReport& report, RunSummary& summary);
 };

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "viscompm/boundary/colliders.hpp"
 #include "viscompm/grid/grid_layout.hpp"
@@ -66,9 +68,10 @@ class TimeIntegrator {
 
   /// Advances `particles` from time t by dt (collective). They change only when the step is
   /// taken: if Newton fails or is interrupted, or the step leaves a non-finite value on any rank,
-  /// they stay exactly as they were and the report says why. A non-empty `dump_prefix` writes
-  /// the first Newton system to PREFIX.mtx / PREFIX_rhs.mtx.
-  StepReport step(particles::ParticleSet& particles, double t, double dt, const std::string& dump_prefix = "");
+  /// they stay exactly as they were and the report says why. With a `dump_prefix`, the first
+  /// Newton system is written to PREFIX.mtx / PREFIX_rhs.mtx.
+  StepReport step(particles::ParticleSet& particles, double t, double dt,
+                  const std::optional<std::string>& dump_prefix = std::nullopt);
 
   // The phases of step(), public for tests and the solver study (step() runs them on its own
   // copy of the particles; called directly, they work on the set they are given).
