@@ -7,7 +7,8 @@ NAME is one of the scenes of inputs/scenes/paper/ (default: OUTPUT_DIR's last fo
 scene's geometry (nozzle, belt, bullet, grips, ground) is read from XML (default
 inputs/scenes/paper/showcase/NAME.xml); --set overrides of a run are not seen, so pass the scene
 file the run used. The frames are read with h5py; connected components and neighbour pairs come
-from scipy (cKDTree, csgraph).
+from scipy (cKDTree, csgraph). Bad input (an option, a missing directory or scene file, a damaged
+frame) ends it with one line on stderr naming what is wrong and exit status 2.
 
 What is measured (doc/scenes.md, "Measured behaviour"):
   weissenberg_sweep  per ball (Wi): lowest height, the rebound (highest top after the lowest), final
@@ -17,11 +18,17 @@ What is measured (doc/scenes.md, "Measured behaviour"):
                      speed x period), and the crests of the deposit's top along the belt (Fig. 5.5)
   shaving_foam,      the stream laid on the ground: its turns around the nozzle's axis (coiling),
   toothpaste         its reversals along the main horizontal direction (S-shaped folding), the
-                     pile's height and width (Figures 5.3, 5.9)
+                     pile's height and width, the laid material's median J = det F (crushed by its
+                     own weight?), and the loop-to-loop contacts: where a later turn or fold of
+                     the laid rope touches an earlier one, and how many of them fuse (a neck of at
+                     least 1.5 rope radii across: merged, not resting on each other as distinct
+                     ropes; see loop_contacts) (Figures 5.3, 5.9)
   pie                crust pieces (connected components of crust particles) against the prescored
-                     slices (the stiff crust's components at frame 0), slices broken across, cream
-                     components by frame (splitting), the crust's velocity along the throw by
-                     frame (does it reach the head?) (Figures 5.6, 5.8)
+                     slices (the stiff crust's components at frame 0), slices broken across, the
+                     groups of slices each piece holds and whether the crust broke along its cuts
+                     (at least 3 pieces, no slice broken across), cream components by frame
+                     (splitting), the crust's velocity along the throw by frame (does it reach the
+                     head?) (Figures 5.6, 5.8)
   twisting_sponge    separated pieces and torn links (lattice neighbours now far apart: the torn
                      area), the grips' turn (Figure 5.1)
   shooting_sponge    the sponge's deformation (rms displacement from frame 0: its peak and how far
