@@ -7,7 +7,8 @@ NAME is one of the scenes of inputs/scenes/paper/ (default: OUTPUT_DIR's last fo
 scene's geometry (nozzle, belt, bullet, grips, ground) is read from XML (default
 inputs/scenes/paper/showcase/NAME.xml); --set overrides of a run are not seen, so pass the scene
 file the run used. The frames are read with h5py; connected components and neighbour pairs come
-from scipy (cKDTree, csgraph).
+from scipy (cKDTree, csgraph). Bad input (an option, a missing directory or scene file, a damaged
+frame) ends it with one line on stderr naming what is wrong and exit status 2.
 
 What is measured (doc/scenes.md, "Measured behaviour"):
   weissenberg_sweep  per ball (Wi): lowest height, the rebound (highest top after the lowest), final
@@ -17,11 +18,17 @@ What is measured (doc/scenes.md, "Measured behaviour"):
                      speed x period), and the crests of the deposit's top along the belt (Fig. 5.5)
   shaving_foam,      the stream laid on the ground: its turns around the nozzle's axis (coiling),
   toothpaste         its reversals along the main horizontal direction (S-shaped folding), the
-                     pile's height and width (Figures 5.3, 5.9)
+                     pile's height and width, the laid material's median J = det F (crushed by its
+                     own weight?), and the loop-to-loop contacts: where a later turn or fold of
+                     the laid rope touches an earlier one, and how many of them fuse (a neck of at
+                     least 1.5 rope radii across: merged, not resting on each other as distinct
+                     ropes; see loop_contacts) (Figures 5.3, 5.9)
   pie                crust pieces (connected components of crust particles) against the prescored
-                     slices (the stiff crust's components at frame 0), slices broken across, cream
-                     components by frame (splitting), the crust's velocity along the throw by
-                     frame (does it reach the head?) (Figures 5.6, 5.8)
+                     slices (the stiff crust's components at frame 0), slices broken across, the
+                     groups of slices each piece holds and whether the crust broke along its cuts
+                     (at least 3 pieces, no slice broken across), cream components by frame
+                     (splitting), the crust's velocity along the throw by frame (does it reach the
+                     head?) (Figures 5.6, 5.8)
   twisting_sponge    separated pieces and torn links (lattice neighbours now far apart: the torn
                      area), the grips' turn (Figure 5.1)
   shooting_sponge    the sponge's deformation (rms displacement from frame 0: its peak and how far
@@ -37,13 +44,37 @@ import re
 import sys
 import xml.etree.ElementTree as ET
 
-import h5py
-import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
+try:
+    import h5py
+    import numpy as np
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+except ImportError as missing:
+    sys.stderr.write(f"measure_scenes.py: needs the Python module {missing.name} (Debian: python3-h5py, "
+                     "python3-numpy, python3-scipy; scripts/setup.sh installs them)\n")
+    sys.exit(2)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+PROGRAM = "measure_scenes.py"
+
+
+class InputError(Exception):
+    """A problem with what the user gave (an option, a directory, a frame or scene file): reported
+    as one line naming it, exit status 2."""
+
+
+def fail(message):
+    """Ends the program with one line on stderr and exit status 2 (never a traceback)."""
+    sys.stderr.write(f"{PROGRAM}: {message}\n")
+    sys.exit(2)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, but a bad or missing argument is one line (the option and what is wrong), exit 2."""
+
+    def error(self, message):
+        fail(f"{message} (see --help)")
 SCENES = ["weissenberg_sweep", "viennetta", "shaving_foam", "toothpaste", "pie", "twisting_sponge",
           "shooting_sponge"]
 
@@ -55,21 +86,32 @@ class Frames:
     """The frames of an output directory, read on demand: frame(i) -> dict of arrays sorted by id."""
 
     def __init__(self, output_dir):
-        files = glob.glob(os.path.join(output_dir, "frame_*.h5"))
+        if not os.path.isdir(output_dir):
+            raise InputError(f"{output_dir}: no such directory")
+        files = [f for f in glob.glob(os.path.join(output_dir, "frame_*.h5")) if re.search(r"frame_(\d+)\.h5$", f)]
         if not files:
-            sys.exit(f"measure_scenes.py: {output_dir}: no frame_NNNNN.h5 files")
+            raise InputError(f"{output_dir}: no frame_NNNNN.h5 files")
         self.paths = {int(re.search(r"frame_(\d+)\.h5$", f).group(1)): f for f in files}
         self.numbers = sorted(self.paths)
 
-    def frame(self, number, fields=("id", "position", "velocity", "material_id")):
-        with h5py.File(self.paths[number], "r") as h5:
-            p = h5["particles"]
-            order = np.argsort(p["id"][...])
-            data = {name: p[name][...][order] for name in fields}
-            data["time"] = float(h5.attrs["time"])
-            names = p.attrs.get("material_names", b"")  # the scene's materials, comma-separated
-            data["material_names"] = (names.decode() if isinstance(names, bytes) else str(names)).split(",")
-            data["volume0_median"] = float(np.median(p["volume0"][...])) if len(order) else 0.0
+    def frame(self, number, fields=("id", "position", "velocity", "material_id"), optional=()):
+        """The frame's `fields` (required) and those of `optional` that the file holds."""
+        path = self.paths[number]
+        try:
+            with h5py.File(path, "r") as h5:
+                p = h5["particles"]
+                order = np.argsort(p["id"][...])
+                data = {name: p[name][...][order] for name in fields}
+                data.update({name: p[name][...][order] for name in optional if name in p})
+                data["time"] = float(h5.attrs["time"])
+                names = p.attrs.get("material_names", b"")  # the scene's materials, comma-separated
+                data["material_names"] = (names.decode() if isinstance(names, bytes) else str(names)).split(",")
+                data["volume0_median"] = float(np.median(p["volume0"][...])) if len(order) else 0.0
+        except KeyError as e:  # a dataset or attribute of doc/contracts.md missing
+            raise InputError(f"{path}: not a viscompm frame: {str(e).strip(chr(39)).strip()}") from None
+        except (OSError, ValueError) as e:  # truncated, damaged or not HDF5
+            reason = str(e).splitlines()[0] if str(e) else type(e).__name__
+            raise InputError(f"{path}: cannot read the frame: {reason}") from None
         return data
 
     def first(self, **kw):
@@ -84,22 +126,36 @@ class SceneFile:
 
     def __init__(self, path):
         self.path = path
-        self.root = ET.parse(path).getroot()
+        try:
+            self.root = ET.parse(path).getroot()
+        except OSError as e:
+            raise InputError(f"{path}: cannot read the scene file: {e.strerror or e}") from None
+        except ET.ParseError as e:
+            raise InputError(f"{path}: not an XML scene file: {e}") from None
 
-    def get(self, path, default=None):
+    REQUIRED = object()
+
+    def get(self, path, default=REQUIRED):
+        """The parameter's value; without a default, a missing or malformed parameter is an
+        InputError naming the file and the parameter."""
         node = self.root
         parts = path.split("/")
         for part in parts[:-1]:
             node = next((c for c in node.findall("ParameterList") if c.get("name") == part), None)
             if node is None:
-                return default
-        leaf = next((c for c in node.findall("Parameter") if c.get("name") == parts[-1]), None)
+                break
+        leaf = None if node is None else next((c for c in node.findall("Parameter") if c.get("name") == parts[-1]), None)
         if leaf is None:
+            if default is SceneFile.REQUIRED:
+                raise InputError(f"{self.path}: no parameter {path} (the measure of this scene needs it)")
             return default
-        value = leaf.get("value")
-        if leaf.get("type", "").startswith("Array"):
-            return np.array([float(v) for v in value.strip("{} ").split(",")])
-        return float(value) if leaf.get("type") in ("double", "int") else value
+        value = leaf.get("value", "")
+        try:
+            if leaf.get("type", "").startswith("Array"):
+                return np.array([float(v) for v in value.strip("{} ").split(",")])
+            return float(value) if leaf.get("type") in ("double", "int") else value
+        except ValueError:
+            raise InputError(f"{self.path}: parameter {path}: '{value}' is not a number") from None
 
     def sublists(self, path):
         node = self.root
@@ -258,11 +314,11 @@ def crests_along_belt(x, h, nozzle_x):
     return result
 
 
-def measure_pile(frames, scene, bin_size):
+def measure_pile(frames, scene, bin_size, link_factor):
     centre = scene.get("Emitters/nozzle/Center")
     speed = float(np.linalg.norm(scene.get("Emitters/nozzle/Velocity")))
     radius = float(scene.get("Emitters/nozzle/Radius"))
-    f = frames.last()
+    f = frames.frame(frames.numbers[-1], optional=("deformation_gradient",))
     h = spacing(f)
     x, v = f["position"], f["velocity"]
     # Laid: slow compared with the stream (which arrives faster than it left the nozzle).
@@ -293,6 +349,83 @@ def measure_pile(frames, scene, bin_size):
     result.update({"coil_turns": turns, "coil_radius_m": float(np.median(np.linalg.norm(around, axis=1))),
                    "fold_reversals": len(swings), "fold_amplitude_m": float(np.ptp(along) / 2),
                    "pile_height_by_frame_m": pile_heights(frames, speed)})
+    if "deformation_gradient" in f:  # crushed by its own weight? J = det F of the laid material
+        result["laid_J_median"] = float(np.median(np.linalg.det(f["deformation_gradient"][laid])))
+    index = np.nonzero(laid)[0]
+    rank = np.empty(len(x), dtype=int)
+    rank[index] = np.arange(len(index))
+    result.update(loop_contacts(x[laid], [rank[b] for b in bins], h, link_factor))
+    return result
+
+
+def loop_contacts(x, bins, h, link_factor, fuse_ratio=1.5, gap_diameters=4.0):
+    """Contacts between different laid turns of a rope, and which of them fuse.
+
+    x: the laid particles; bins: index arrays into x, consecutive pieces of the rope in emission
+    order. The rope's radius r is the median over the bins of 2 sqrt(the middle eigenvalue of the
+    piece's covariance) (a straight piece of a round rope: its two cross-section eigenvalues are
+    r^2/4, whether the piece is longer or shorter than wide). Two particles closer than
+    link_factor * h belong to a loop-to-loop contact when the rope between their pieces (the path
+    of the pieces' centres) is at least `gap_diameters` rope diameters long: a later turn or fold
+    laid on or beside an earlier one, not the rope's own neighbours. Per pair of pieces in contact,
+    the neck is the extent of the contact's particles (those of each piece within the link of the
+    other) across rope a (along n x t_a: n joins the pieces' centres, t_a is rope a's direction),
+    plus one spacing. Touching pieces of pairs adjacent in both ropes are one contact; a contact
+    fuses when its median neck is at least fuse_ratio * r: the ropes have run into each other over
+    most of their width (two round ropes only touching meet over about 2 sqrt(r h), which is less
+    than 1.5 r once the rope is more than about 2 spacings thick), rather than resting on each other
+    as distinct ropes."""
+    bins = [b for b in bins if len(b) >= 4]
+    if len(bins) < 3:
+        return {"loop_contacts": 0, "loop_contacts_fused": 0, "note_contacts": "too few pieces of rope"}
+    centres = np.array([x[b].mean(axis=0) for b in bins])
+    radii = [2.0 * math.sqrt(max(np.linalg.eigvalsh(np.cov(x[b].T))[1], 0.0)) for b in bins]
+    r = float(np.median(radii))
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(centres, axis=0), axis=1))])
+    tangent = np.gradient(centres, axis=0)
+    tangent /= np.maximum(np.linalg.norm(tangent, axis=1), 1e-300)[:, None]
+    piece = np.full(len(x), -1)
+    for k, b in enumerate(bins):
+        piece[b] = k
+    pairs = cKDTree(x).query_pairs(link_factor * h, output_type="ndarray")
+    pairs = pairs[(piece[pairs[:, 0]] >= 0) & (piece[pairs[:, 1]] >= 0)]
+    a, b = piece[pairs[:, 0]], piece[pairs[:, 1]]
+    swap = a > b
+    pairs[swap] = pairs[swap][:, ::-1]
+    a, b = np.minimum(a, b), np.maximum(a, b)
+    apart = along[b] - along[a] >= gap_diameters * 2.0 * r
+    pairs, a, b = pairs[apart], a[apart], b[apart]
+    result = {"rope_radius_m": r, "loop_gap_m": gap_diameters * 2.0 * r}
+    if len(pairs) == 0:
+        result.update({"loop_contacts": 0, "loop_contacts_fused": 0})
+        return result
+    keys = sorted(set(zip(a.tolist(), b.tolist())))
+    neck = {}
+    for ka, kb in keys:
+        mine = (a == ka) & (b == kb)
+        touching = np.unique(np.concatenate([pairs[mine, 0], pairs[mine, 1]]))
+        n = centres[kb] - centres[ka]
+        across = np.cross(n, tangent[ka])
+        if np.linalg.norm(across) < 1e-12 * max(np.linalg.norm(n), 1e-300):
+            across = np.cross(tangent[kb], tangent[ka])  # the pieces' centres meet: cross the ropes
+        across /= max(np.linalg.norm(across), 1e-300)
+        neck[(ka, kb)] = float(np.ptp(x[touching] @ across)) + h
+    # Contacts: pairs of pieces adjacent in both ropes (parallel or antiparallel) are one contact.
+    index = {k: i for i, k in enumerate(keys)}
+    rows, cols = [], []
+    for (ka, kb), i in index.items():
+        for da in (-1, 0, 1):
+            for db in (-1, 0, 1):
+                j = index.get((ka + da, kb + db))
+                if j is not None:
+                    rows.append(i)
+                    cols.append(j)
+    count, labels = connected_components(coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(keys),) * 2),
+                                         directed=False)
+    necks = [float(np.median([neck[k] for k, l in zip(keys, labels) if l == c])) for c in range(count)]
+    result.update({"loop_contacts": count,
+                   "loop_contacts_fused": int(sum(w >= fuse_ratio * r for w in necks)),
+                   "loop_contact_necks_over_rope_radius": sorted((round(w / r, 2) for w in necks), reverse=True)})
     return result
 
 
@@ -342,6 +475,13 @@ def measure_pie(frames, scene, link_factor):
                         for q in set(stiff_pieces)), reverse=True)
     result["slices_per_crust_piece"] = [n for n in per_piece if n > 0]
     result.update({"time": last["time"], "slices_broken_across": split})
+    # Broken along the cuts: at least 3 pieces, each a group of whole slices (none broken across);
+    # the groups, by frame-0 slice number (slices numbered by their first particle's id).
+    rename = {s: i for i, s in enumerate(sorted(big, key=lambda s: stiff_ids0[slice_labels == s].min()))}
+    groups = sorted(sorted(rename[s] for s in set(slice_of_stiff[stiff_pieces == q]) if s in big)
+                    for q in set(stiff_pieces))
+    result["crust_slice_groups"] = [g for g in groups if g]
+    result["crust_broken_along_cuts"] = bool(split == 0 and len(result["crust_slice_groups"]) >= 3)
     # Whether the crust reaches the head: its mean velocity along the throw, frame by frame.
     throw = first["velocity"][stiff0].mean(axis=0)
     throw /= max(np.linalg.norm(throw), 1e-300)
@@ -434,30 +574,55 @@ def measure_shooting(frames, scene, link_factor, tear_factor):
 
 # ---------------------------------------------------------------------------------------------
 
+def positive(kind):
+    def read(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a{'n integer' if kind is int else ' number'}") from None
+        if not value > 0:
+            raise argparse.ArgumentTypeError(f"'{text}' is not positive")
+        return value
+    return read
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = Parser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("output_dir")
     ap.add_argument("--scene", choices=SCENES, help="the scene (default: the output directory's name)")
     ap.add_argument("--scene-file", help="the scene XML the run used (default inputs/scenes/paper/showcase/NAME.xml)")
-    ap.add_argument("--link", type=float, default=1.5,
+    ap.add_argument("--link", type=positive(float), default=1.5,
                     help="particles closer than this many particle spacings are connected (default 1.5)")
-    ap.add_argument("--tear", type=float, default=3.0,
+    ap.add_argument("--tear", type=positive(float), default=3.0,
                     help="a lattice link is torn when longer than this many spacings (default 3)")
-    ap.add_argument("--bin", type=int, default=400,
+    ap.add_argument("--bin", type=positive(int), default=400,
                     help="streams: particles per bin of emission order, several nozzle layers (default 400)")
     ap.add_argument("--json", help="also write the measurements to this JSON file")
     args = ap.parse_args()
     name = args.scene or os.path.basename(os.path.normpath(args.output_dir))
     if name not in SCENES:
-        sys.exit(f"measure_scenes.py: unknown scene '{name}' (give --scene, one of {', '.join(SCENES)})")
+        fail(f"{args.output_dir}: unknown scene '{name}' (give --scene, one of {', '.join(SCENES)})")
+    try:
+        measure_run(args, name)
+    except InputError as e:
+        fail(str(e))
+    except OSError as e:  # writing --json
+        fail(f"{e.filename or ''}: {e.strerror or e}")
+    except Exception as e:  # noqa: BLE001 - frames that do not fit what the measure expects
+        sys.stderr.write(f"{PROGRAM}: {args.output_dir}: cannot measure {name}: {type(e).__name__}: "
+                         f"{str(e).splitlines()[0] if str(e) else ''}\n")
+        sys.exit(1)
+
+
+def measure_run(args, name):
     scene_file = args.scene_file or os.path.join(HERE, os.pardir, "inputs", "scenes", "paper", "showcase", name + ".xml")
     scene = SceneFile(scene_file)
     frames = Frames(args.output_dir)
     measure = {
         "weissenberg_sweep": lambda: measure_weissenberg(frames, scene),
         "viennetta": lambda: measure_viennetta(frames, scene, args.bin),
-        "shaving_foam": lambda: measure_pile(frames, scene, args.bin),
-        "toothpaste": lambda: measure_pile(frames, scene, args.bin),
+        "shaving_foam": lambda: measure_pile(frames, scene, args.bin, args.link),
+        "toothpaste": lambda: measure_pile(frames, scene, args.bin, args.link),
         "pie": lambda: measure_pie(frames, scene, args.link),
         "twisting_sponge": lambda: measure_twisting(frames, scene, args.link, args.tear),
         "shooting_sponge": lambda: measure_shooting(frames, scene, args.link, args.tear),

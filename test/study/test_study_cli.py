@@ -115,6 +115,7 @@ check(len(rows) == 1 and int(rows[0]["dofs"]) > 0 and int(rows[0]["nonzeros"]) >
 run_dir = os.path.join(args.workdir, "run")
 result = run(args.viscompm, os.path.join(args.inputs, "scenes", "shooting_sponge.xml"), "--output", run_dir,
              "--frames", "1", "--set", "Grid/Cell size=0.06", "--set", "Output/Matrix Market steps={2}",
+             "--set", "Newton/Linear tolerance=fixed", "--set", "Newton/Hessian update=every iteration",
              "--solver", os.path.join(solvers, "jacobi_cg.xml"))
 check(result.returncode == 0, f"run with a MatrixMarket dump exits 0: {result.stderr[-1500:]}")
 logged = [r for r in csv.DictReader(open(os.path.join(run_dir, "solver.csv")))
@@ -221,13 +222,15 @@ with open(steps_study, "w") as f:
   <ParameterList name="Configurations">
     <ParameterList name="exact Newton">
       <Parameter name="Solver" type="string" value="{solvers}/jacobi_cg.xml"/>
+      <Parameter name="Newton" type="Array(string)" value="{{Linear tolerance=fixed, Hessian update=every iteration}}"/>
     </ParameterList>
     <ParameterList name="once per step">
       <Parameter name="Solver" type="string" value="{solvers}/jacobi_cg.xml"/>
-      <Parameter name="Newton" type="Array(string)" value="{{Hessian update=every step}}"/>
+      <Parameter name="Newton" type="Array(string)" value="{{Linear tolerance=fixed, Hessian update=every step}}"/>
     </ParameterList>
     <ParameterList name="paper">
       <Parameter name="Solver" type="string" value="{solvers}/matrix_free_jacobi_cg.xml"/>
+      <Parameter name="Newton" type="Array(string)" value="{{Linear tolerance=fixed, Hessian update=every iteration}}"/>
     </ParameterList>
   </ParameterList>
 </ParameterList>""")
