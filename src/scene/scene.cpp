@@ -602,7 +602,7 @@ constexpr double max_stiffness_ratio = 1.0 / std::numeric_limits<double>::epsilo
 //   (λ + 2μ)·Δt² / (ρ·Δx²) = (c·Δt/Δx)², beyond max_stiffness_ratio at Δt = Min time step.
 void check_physical_bounds(const SceneConfig& scene) {
   const double dx = scene.grid.cell_size, dt = scene.simulation.min_time_step;
-  const double g = scene.simulation.gravity.norm();
+  const double g = scene.simulation.gravity.stableNorm();  // no overflow: 1e300 stays 1e300
   const double g_max = scene.simulation.cfl * dx / (dt * dt);
   if (!(g <= g_max)) {
     std::ostringstream reason;
