@@ -34,6 +34,7 @@ struct NewtonSystem::Impl {
   Teuchos::RCP<multivector_type> stiff_modes;           // Deflation: Z of the last assembly (null: none)
   Teuchos::RCP<DeflatedPreconditioner> deflated;        // the preconditioner with Z deflated
   int stiff_bodies = 0;
+  bool last_assembly_projected = false;  // whether the last assembly projected H to PSD
 
   /// The operator CG is preconditioned with (null: none).
   Teuchos::RCP<operator_type> preconditioner_op() const {
@@ -144,6 +145,7 @@ double NewtonSystem::assemble(const implicit::IncrementalPotential& potential, c
   Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
   m.hessian->update(potential, v, project);
+  m.last_assembly_projected = project;
   if (m.config.impl().settings.deflation == Deflation::stiff_bodies) m.build_stiff_modes(potential);
   return seconds_since(start);
 }
@@ -263,10 +265,17 @@ std::vector<std::tuple<long long, long long, double>> NewtonSystem::gather_entri
   return entries;
 }
 
-void NewtonSystem::write_matrix_market(const std::string& prefix, const NodeVectorField& rhs) const {
+void NewtonSystem::write_matrix_market(const std::string& prefix, const implicit::IncrementalPotential& potential,
+                                       const NodeVectorField& v, const NodeVectorField& rhs) const {
   const Impl& m = *impl_;
-  const auto matrix = m.hessian->matrix();
-  if (matrix.is_null()) throw std::logic_error("write_matrix_market: the operator is matrix-free");
+  auto matrix = m.hessian->matrix();
+  std::unique_ptr<HessianOperator> assembled;  // the matrix-free operator's H, for the file only
+  if (matrix.is_null()) {
+    assembled = make_assembled_hessian(m.space);
+    assembled->build_pattern();
+    assembled->update(potential, v, m.last_assembly_projected);
+    matrix = assembled->matrix();
+  }
   multivector_type b(m.space.impl().owned_dof_map, 1);
   m.to_owned(rhs, b);
   write_contiguous_matrix_market(*matrix, b, *m.modes.coordinates, prefix);

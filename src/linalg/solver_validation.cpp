@@ -207,6 +207,14 @@ void validate_ifpack2_parameters(const std::string& type, const Teuchos::Paramet
   check_work_counts(given, origin, path);
   // Words Ifpack2 13.2 checks only once it has a matrix (BlockRelaxation::initialize).
   check_word(given, "partitioner: type", {"linear", "line", "user"}, origin, path);
+  // AdditiveSchwarz creates its inner solver by name only in initialize() (found by fuzzing).
+  for (const char* name : {"inner preconditioner name", "subdomain solver name", "schwarz: inner preconditioner name",
+                           "schwarz: subdomain solver name"})
+    if (given.isType<std::string>(name) &&
+        !Ifpack2::Factory::isSupported<crs_matrix_type>(given.get<std::string>(name)))
+      fail(origin, joined(path, name),
+           "'" + given.get<std::string>(name) + "' is not an Ifpack2 preconditioner" +
+               hint(given.get<std::string>(name), {"AMESOS2", "RILUK", "ILUT", "RELAXATION", "CHEBYSHEV", "DENSE"}));
   // The preconditioner of that type, without a matrix, checks the values itself: its list of
   // valid parameters with validators where it has one, and setParameters.
   Teuchos::RCP<ifpack2_preconditioner_type> prec;

@@ -61,7 +61,8 @@ StepReport TimeIntegrator::step(particles::ParticleSet& own_particles, double t,
     newton::SystemObserver dump;
     if (dump_prefix)
       dump = [&](int iteration, const linalg::NewtonSystem& system, const NodeVectorField& rhs) {
-        if (iteration == 1) system.write_matrix_market(*dump_prefix, rhs);
+        // The first Newton iteration's H is assembled at the initial guess.
+        if (iteration == 1) system.write_matrix_market(*dump_prefix, *objective->potential, objective->initial_guess, rhs);
       };
     report.newton = newton_.solve(*objective->potential, v, dump);
   }

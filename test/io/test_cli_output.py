@@ -140,7 +140,11 @@ if os.path.exists(csv_path):
           f"solver.csv header {header}")
     check(len(rows) > 0, "solver.csv has rows")
     check(all(int(r[7]) == args.ranks for r in rows), "ranks column")
-    check(all(float(r[3]) < 1e-5 for r in rows), "relative residuals meet the solver tolerance")
+    # Each solve reaches the tolerance it was given (the scene's inexact Newton gives forcing
+    # terms below 1: doc/inputs.md, Linear tolerance).
+    check(all(0 < float(r[9]) < 1 and float(r[3]) <= float(r[9]) for r in rows),
+          "relative residuals meet the solver tolerance of their row: "
+          + str([(r[3], r[9]) for r in rows if not float(r[3]) <= float(r[9])][:5]))
     newton_total = int(result.stdout.split("Newton iterations")[0].split(",")[-1]) if "Newton iterations" in result.stdout else -1
     check(len(rows) == newton_total, f"one row per Newton iteration: {len(rows)} vs {newton_total}")
 

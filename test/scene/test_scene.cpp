@@ -503,6 +503,14 @@ TEST(SolverConfiguration, ValidatesMueLuAndIfpack2NamesTypesAndValues) {
   expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/aggregation: type");
   m = solver_error("MueLu", parameter("coarse: type", "string", "KLU3"));
   expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/coarse: type");
+  // The coarse solver's inner solver, created by name only at set-up (found by fuzzing).
+  m = solver_error("MueLu", parameter("coarse: type", "string", "SCHWARZ") + "<ParameterList name=\"coarse: params\">" +
+                                parameter("inner preconditioner name", "string", "1e-300") + "</ParameterList>");
+  expect_one_line_naming(m, "solver.xml", "Preconditioner parameters/coarse: params/inner preconditioner name");
+  EXPECT_NE(m.find("is not an Ifpack2 preconditioner"), std::string::npos) << m;
+  m = solver_error("MueLu", parameter("coarse: type", "string", "SCHWARZ") + "<ParameterList name=\"coarse: params\">" +
+                                parameter("inner preconditioner name", "string", "AMESOS2") + "</ParameterList>");
+  EXPECT_EQ(m, "") << m;
   // Belos: a tolerance that would never be met, no iterations, a non-finite number.
   m = solver_error("none", "", "", parameter("Convergence Tolerance", "double", "-1e-6"));
   expect_one_line_naming(m, "solver.xml", "Krylov parameters/Convergence Tolerance");

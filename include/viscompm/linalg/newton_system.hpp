@@ -67,9 +67,12 @@ class NewtonSystem {
   /// Every entry of H as (row, column, value) with grid dof ids 3·(grid node id) + d, which do not
   /// depend on the rank count; on every rank, sorted (collective; assembled operators only).
   std::vector<std::tuple<long long, long long, double>> gather_entries() const;
-  /// Writes H and a right-hand side (owned entries of `rhs`) to PREFIX.mtx and PREFIX_rhs.mtx,
-  /// renumbered to contiguous indices 1..n (collective; assembled operators only).
-  void write_matrix_market(const std::string& prefix, const NodeVectorField& rhs) const;
+  /// Writes H of the last assembly at grid velocities v and a right-hand side (owned entries of
+  /// `rhs`) to PREFIX.mtx and PREFIX_rhs.mtx, renumbered to contiguous indices 1..n. A
+  /// matrix-free operator's H is assembled for the file from the same per-particle pieces
+  /// (collective).
+  void write_matrix_market(const std::string& prefix, const implicit::IncrementalPotential& potential,
+                           const NodeVectorField& v, const NodeVectorField& rhs) const;
   /// Seconds per application of H (mean of `repetitions`), for benchmarks (collective).
   double time_apply(int repetitions) const;
   /// Seconds per application of the preconditioner (mean of `repetitions`; 0 without one): one
