@@ -83,6 +83,12 @@ int run_simulation_program(int argc, char** argv) {
                 << " particles migrated; " << summary.particles_deleted << " particles deleted, "
                 << summary.rebalances << " rebalances\n"
                 << "output: " << scene.output.directory << "/particles.xdmf (ParaView), frame_*.h5, solver.csv\n";
+    if (const auto* choice = simulation.integrator().solver_choice(); choice != nullptr && root) {
+      std::cout << solver.label() << ":";
+      for (std::size_t k = 0; k < solver.candidates().size(); ++k)
+        std::cout << (k == 0 ? " " : ", ") << solver.candidates()[k].label() << " " << choice->systems()[k] << " steps";
+      std::cout << "; " << choice->trials() << " trials, " << choice->switches() << " switches\n";
+    }
     return exit_success;
   });
 }

@@ -4,6 +4,8 @@
 #include <BelosTpetraAdapter.hpp>
 #include <Teuchos_XMLParameterListCoreHelpers.hpp>
 
+#include <fstream>
+
 #include "solver_configuration_impl.hpp"
 #include "solver_validation.hpp"
 #include "viscompm/core/error.hpp"
@@ -183,9 +185,85 @@ std::shared_ptr<SolverConfiguration::Impl> parse(const Teuchos::ParameterList& l
 }
 }  // namespace
 
+namespace {
+// A measured choice's file: its candidates and the schedule of its trials.
+struct ChoiceFile {
+  std::string label;
+  StringList candidates;
+  int trial_systems = 1;
+  int recheck_systems = 16;
+  int max_recheck_systems = 256;
+  double regime_change = 2.0;
+  int regime_systems = 4;
+
+  SolverChoiceSettings schedule() const {
+    return {trial_systems, recheck_systems, max_recheck_systems, regime_change, regime_systems};
+  }
+  static const ParameterTable<ChoiceFile>& table() {
+    static const ParameterTable<ChoiceFile> t = [] {
+      ParameterTable<ChoiceFile> table;
+      using C = ChoiceFile;
+      table.string(&C::label, "Label", "measured choice", {}, "name of this choice in messages")
+          .string_list(&C::candidates, "Choose between", {},
+                       "solver files (relative to this one) of which the run uses the cheapest per Newton system, as measured")
+          .integer(&C::trial_systems, "Trial systems", 1, Range::closed(1, 100), "Newton systems each candidate solves in a trial")
+          .integer(&C::recheck_systems, "Recheck systems", 16, Range::closed(1, 1000000),
+                   "Newton systems of the chosen one before the others are tried again")
+          .integer(&C::max_recheck_systems, "Max recheck systems", 256, Range::closed(1, 1000000),
+                   "the interval between trials doubles, each time a trial confirms the choice, up to this")
+          .real(&C::regime_change, "Regime change", 2.0, Range::open_closed(1.0, 1e6),
+                "a trial at once when the chosen one's recent seconds per Newton system move by this factor from its trial's")
+          .integer(&C::regime_systems, "Regime systems", 4, Range::closed(1, 1000000),
+                   "Newton systems after a trial before a regime change is looked for");
+      return table;
+    }();
+    return t;
+  }
+};
+
+std::string directory_of(const std::string& file) {
+  const auto slash = file.find_last_of('/');
+  return slash == std::string::npos ? std::string() : file.substr(0, slash + 1);
+}
+
+// A file with `Choose between` is a measured choice; its candidates are read as files of their
+// own (each validated as usual; a candidate that is itself a choice is bad input).
+std::shared_ptr<SolverConfiguration::Impl> parse_choice(const Teuchos::ParameterList& list, const std::string& origin,
+                                                        const std::string& directory) {
+  auto impl = std::make_shared<SolverConfiguration::Impl>();
+  impl->origin = origin;
+  const ChoiceFile file = ChoiceFile::table().parse(params::read_parameters(list, ChoiceFile::table().specs(), origin, ""));
+  if (file.candidates.size() < 2)
+    throw parameter_error(origin, "Choose between", "a measured choice needs at least two solver files, got " +
+                                                        std::to_string(file.candidates.size()));
+  if (file.max_recheck_systems < file.recheck_systems)
+    throw parameter_error(origin, "Max recheck systems", "is less than Recheck systems (" +
+                                                           std::to_string(file.recheck_systems) + ")");
+  for (const std::string& name : file.candidates) {
+    const std::string path = !name.empty() && name[0] == '/' ? name : directory + name;
+    if (!std::ifstream(path))
+      throw parameter_error(origin, "Choose between", "cannot open '" + path + "'");
+    SolverConfiguration candidate = SolverConfiguration::read(path);
+    if (candidate.is_choice())
+      throw parameter_error(origin, "Choose between", "'" + name + "' is itself a measured choice");
+    impl->candidates.push_back(std::move(candidate));
+  }
+  impl->choice = file.schedule();
+  impl->settings.label = file.label;
+  impl->krylov_parameters = Teuchos::rcp(new Teuchos::ParameterList());
+  impl->preconditioner_parameters = Teuchos::rcp(new Teuchos::ParameterList());
+  return impl;
+}
+
+std::shared_ptr<SolverConfiguration::Impl> parse_file(const Teuchos::ParameterList& list, const std::string& origin,
+                                                      const std::string& directory) {
+  return list.isParameter("Choose between") ? parse_choice(list, origin, directory) : parse(list, origin);
+}
+}  // namespace
+
 SolverConfiguration SolverConfiguration::read(const std::string& file) {
   SolverConfiguration c;
-  c.impl_ = parse(*params::read_xml_file(file), file);
+  c.impl_ = parse_file(*params::read_xml_file(file), file, directory_of(file));
   return c;
 }
 
@@ -197,12 +275,13 @@ SolverConfiguration SolverConfiguration::from_xml(const std::string& xml, const 
   } catch (const std::exception& e) {
     throw InputError(origin + ": not a valid XML parameter list");
   }
-  c.impl_ = parse(*list, origin);
+  c.impl_ = parse_file(*list, origin, "");
   return c;
 }
 
 const std::string& SolverConfiguration::label() const { return impl_->settings.label; }
 void SolverConfiguration::check_rank_count(int ranks) const {
+  for (const auto& candidate : impl_->candidates) candidate.check_rank_count(ranks);
   const int most = impl_->settings.max_ranks;
   if (most > 0 && ranks > most)
     throw parameter_error(origin(), "Ranks", "this solver file runs on at most " + std::to_string(most) +
@@ -210,6 +289,8 @@ void SolverConfiguration::check_rank_count(int ranks) const {
 }
 
 const std::string& SolverConfiguration::origin() const { return impl_->origin; }
+const std::vector<SolverConfiguration>& SolverConfiguration::candidates() const { return impl_->candidates; }
+const SolverChoiceSettings& SolverConfiguration::choice() const { return impl_->choice; }
 bool SolverConfiguration::matrix_free() const { return impl_->settings.operator_form == OperatorForm::matrix_free; }
 
 }  // namespace viscompm::linalg

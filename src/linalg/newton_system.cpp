@@ -140,6 +140,13 @@ void NewtonSystem::build_pattern() {
   m.pattern_version = m.space.version();
 }
 
+double NewtonSystem::prepare() {
+  if (impl_->pattern_version == impl_->space.version()) return 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  build_pattern();
+  return seconds_since(start);
+}
+
 double NewtonSystem::assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v,
                               bool project) {
   Impl& m = *impl_;

@@ -417,6 +417,11 @@ class MueLuPreconditioner : public Preconditioner {
     const SolverSettings& settings = config_.impl().settings;
     if (settings.smoother_blocks == SmootherBlocks::grid_lines) set_fine_smoother_damping(A);
     if (settings.cycle != Cycle::lean) return;
+    // A grid at most Coarsest nodes large is one level, solved by the coarse solver: no cycle.
+    if (prec_->GetHierarchy()->GetNumLevels() < 2) {
+      lean_ = Teuchos::null;
+      return;
+    }
     if (pattern_changed || !lean_lines_)
       lean_lines_ = std::make_shared<LineSmoother>(grid::node_lines(grid_of(modes)->owned_nodes, settings.line_length));
     lean_lines_->compute(A, *H.op(), settings.line_damping);

@@ -59,6 +59,8 @@ struct SolverConfiguration::Impl {
   SolverSettings settings;
   Teuchos::RCP<Teuchos::ParameterList> krylov_parameters;
   Teuchos::RCP<Teuchos::ParameterList> preconditioner_parameters;
+  std::vector<SolverConfiguration> candidates;  ///< a measured choice's (empty: one configuration)
+  SolverChoiceSettings choice;
 };
 
 }  // namespace viscompm::linalg

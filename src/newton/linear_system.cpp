@@ -12,6 +12,7 @@ class SimulationSystem : public LinearSystem {
     return system_.assemble(potential, v, project);
   }
   double precondition() override { return system_.precondition(); }
+  double prepare() override { return system_.prepare(); }
   linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) override {
     return system_.solve(rhs, dv, tolerance);
   }

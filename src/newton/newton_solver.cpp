@@ -71,26 +71,43 @@ struct NewtonSolver::Step {
 
 NewtonSolver::NewtonSolver(const NewtonSettings& settings, linalg::NewtonSystem& system,
                            const parallel::Communicator& comm)
-    : settings_(settings),
-      owned_system_(make_linear_system(system)),
-      system_(*owned_system_),
-      comm_(comm),
-      rules_(settings),
-      lbfgs_(settings.lbfgs_pairs) {}
+    : settings_(settings), comm_(comm), lbfgs_(settings.lbfgs_pairs) {
+  owned_systems_.push_back(make_linear_system(system));
+  systems_.push_back(owned_systems_.back().get());
+  rules_.emplace_back(settings);
+  begun_.assign(1, false);
+}
 
 NewtonSolver::NewtonSolver(const NewtonSettings& settings, LinearSystem& system, const parallel::Communicator& comm)
-    : settings_(settings), system_(system), comm_(comm), rules_(settings), lbfgs_(settings.lbfgs_pairs) {}
+    : settings_(settings), systems_{&system}, comm_(comm), lbfgs_(settings.lbfgs_pairs) {
+  rules_.emplace_back(settings);
+  begun_.assign(1, false);
+}
+
+NewtonSolver::NewtonSolver(const NewtonSettings& settings, const std::vector<linalg::NewtonSystem*>& candidates,
+                           const linalg::SolverChoiceSettings& choice, const parallel::Communicator& comm)
+    : settings_(settings), comm_(comm), lbfgs_(settings.lbfgs_pairs) {
+  for (linalg::NewtonSystem* candidate : candidates) {
+    owned_systems_.push_back(make_linear_system(*candidate));
+    systems_.push_back(owned_systems_.back().get());
+    rules_.emplace_back(settings);
+  }
+  begun_.assign(systems_.size(), false);
+  choice_.emplace(static_cast<int>(systems_.size()), choice);
+}
 
 NewtonSolver::~NewtonSolver() = default;
 
-void NewtonSolver::forget() { rules_.forget(); }
+void NewtonSolver::forget() {
+  for (auto& rules : rules_) rules.forget();
+}
 
 NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential, NodeVectorField& v,
                                  const SystemObserver& observer) {
   Step step{potential, v, observer, {}, {}, {}, {}, -1};
   NewtonReport& report = step.report;
   report.tolerance = settings_.tolerance * potential.layout().geometry.dx / potential.dt();
-  rules_.begin_solve(potential.dt(), system_.pattern_version(), system_.matrix_free());
+  std::fill(begun_.begin(), begun_.end(), false);
   lbfgs_.clear();
   NodeVectorField g, dv;
   // A counted loop: `Max iterations` directions at most, each after the residual and its tests;
@@ -102,15 +119,36 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
   for (int direction = 0; direction < settings_.max_iterations; ++direction) {
     if (residual_settles(step, g) || stop_requested(step)) return finish();
     ++report.iterations;
+    const auto start = std::chrono::steady_clock::now();
+    select_candidate(step);
     // Direction, then the line search along it (both inside: a failed line search may call for a
     // fresh or projected Hessian).
+    const std::size_t solves = report.linear_solves.size();
     const bool moved = settings_.method == Method::lbfgs ? lbfgs_direction_and_line_search(step, g, dv)
                                                          : newton_direction_and_line_search(step, g, dv);
+    if (choice_) {
+      // The direction's cost, the same on every rank, per decade its solve reduced the residual
+      // (a later Newton iteration asks CG for more than the first).
+      const double tolerance = report.linear_solves.size() > solves ? report.linear_solves.back().tolerance : 0.0;
+      const double decades = tolerance > 0.0 && tolerance < 0.1 ? -std::log10(tolerance) : 1.0;
+      choice_->solved(comm_.max(seconds_since(start)) / decades);
+    }
     if (!moved) return finish();
   }
   if (!residual_settles(step, g) && report.failure.empty())
     report.failure = "no convergence in " + std::to_string(settings_.max_iterations) + " iterations";
   return finish();
+}
+
+void NewtonSolver::select_candidate(Step& step) {
+  const int next = choice_ ? choice_->next() : 0;
+  if (next != current_) lbfgs_.clear();  // L-BFGS pairs belong to the H₀ they were built with
+  if (next != current_ && step.lbfgs_age >= 0) step.lbfgs_age = -1;
+  current_ = next;
+  if (begun_[current_]) return;
+  system().prepare();
+  rules().begin_solve(step.potential.dt(), system().pattern_version(), system().matrix_free());
+  begun_[current_] = true;
 }
 
 bool NewtonSolver::residual_settles(Step& step, NodeVectorField& g) {
@@ -127,7 +165,7 @@ bool NewtonSolver::residual_settles(Step& step, NodeVectorField& g) {
     }
   }
   const double residual = velocity_residual(step.potential, g, comm_);
-  if (!report.residual_history.empty()) rules_.residual(report.residual_history.back(), residual);
+  if (!report.residual_history.empty()) rules().residual(report.residual_history.back(), residual);
   report.residual = residual;
   report.residual_history.push_back(residual);
   // Convergence test.
@@ -148,7 +186,7 @@ bool NewtonSolver::stop_requested(Step& step) const {
 }
 
 double NewtonSolver::forcing(const Step& step) const {
-  if (settings_.linear_tolerance == LinearTolerance::fixed) return system_.default_tolerance();
+  if (settings_.linear_tolerance == LinearTolerance::fixed) return system().default_tolerance();
   const auto& r = step.report.residual_history;
   double eta = settings_.forcing_max;
   if (r.size() >= 2) {
@@ -161,22 +199,22 @@ double NewtonSolver::forcing(const Step& step) const {
   }
   // No oversolving near the end: a residual reduction to half the Newton tolerance suffices.
   eta = std::max(eta, 0.5 * step.report.tolerance / r.back());
-  return std::clamp(eta, system_.default_tolerance(), settings_.forcing_max);
+  return std::clamp(eta, system().default_tolerance(), settings_.forcing_max);
 }
 
 void NewtonSolver::assemble(Step& step, bool project) {
   Teuchos::TimeMonitor t(assemble_timer());
-  const double seconds = system_.assemble(step.potential, step.v, project);
+  const double seconds = system().assemble(step.potential, step.v, project);
   step.report.linear_solves.back().operator_seconds += seconds;
   ++step.report.assemblies;
-  rules_.assembled(project);
+  rules().assembled(project);
 }
 
 void NewtonSolver::precondition(Step& step) {
   Teuchos::TimeMonitor t(precondition_timer());
-  step.report.linear_solves.back().setup_seconds += system_.precondition();
+  step.report.linear_solves.back().setup_seconds += system().precondition();
   ++step.report.preconditioner_setups;
-  rules_.preconditioned();
+  rules().preconditioned();
 }
 
 bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv) {
@@ -188,8 +226,8 @@ bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVector
   // The attempts, in order: (1) as the strategy says — a kept or fresh H, exact unless projection
   // is always on or the kept H is projected; (2) a fresh H and preconditioner, if (1) used anything
   // kept; (3) the fresh projected H, if the last H was exact and projection is adaptive.
-  Attempt attempt{rules_.assemble_now(), always};
-  if (!attempt.fresh) attempt.project = rules_.kept_projected();
+  Attempt attempt{rules().assemble_now(), always};
+  if (!attempt.fresh) attempt.project = rules().kept_projected();
   for (int k = 0; k < direction_attempts; ++k) {
     if (k > 0 && stop_requested(step)) return false;
     bool used_kept = false;
@@ -201,7 +239,7 @@ bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVector
     } else {
       break;
     }
-    rules_.demand_fresh();  // the next attempt sets up its own preconditioner
+    rules().demand_fresh();  // the next attempt sets up its own preconditioner
   }
   if (step.report.failure.empty()) {
     const linalg::LinearSolveReport& last = step.report.linear_solves.back();
@@ -220,21 +258,21 @@ bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, 
   report.linear_solves.emplace_back();  // the solve of this attempt
   if (attempt.fresh) {
     assemble(step, attempt.project);
-    if (step.observer && system_.newton_system()) step.observer(report.iterations, *system_.newton_system(), rhs);
+    if (step.observer && system().newton_system()) step.observer(report.iterations, *system().newton_system(), rhs);
   }
-  if (rules_.setup_now()) precondition(step);
-  used_kept = !attempt.fresh || !rules_.preconditioner_matches_hessian();
+  if (rules().setup_now()) precondition(step);
+  used_kept = !attempt.fresh || !rules().preconditioner_matches_hessian();
   linalg::LinearSolveReport& solve = report.linear_solves.back();
   {
     Teuchos::TimeMonitor t(cg_timer());
     // The solve's report, with this attempt's assembly and set-up times kept.
     const double operator_seconds = solve.operator_seconds, setup_seconds = solve.setup_seconds;
-    solve = system_.solve(rhs, dv, tolerance);
+    solve = system().solve(rhs, dv, tolerance);
     solve.operator_seconds = operator_seconds;
     solve.setup_seconds = setup_seconds;
   }
   report.projected_solves += attempt.project;
-  rules_.solved(solve.iterations, solve.tolerance);
+  rules().solved(solve.iterations, solve.tolerance);
 
   step.potential.constraints().project(dv);
   const double slope = -owned_dot(rhs, dv, step.potential.layout().owned_count, comm_);  // ∇E·dv
@@ -246,7 +284,7 @@ bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, 
 }
 
 void NewtonSolver::rebuild_initial_inverse(Step& step) {
-  step.report.linear_solves.back().preconditioner = system_.label();
+  step.report.linear_solves.back().preconditioner = system().label();
   assemble(step, true);
   precondition(step);
   lbfgs_.clear();
@@ -269,7 +307,7 @@ bool NewtonSolver::lbfgs_direction_and_line_search(Step& step, const NodeVectorF
     lbfgs_.add(std::move(step.lbfgs_step), std::move(y), dot);
   }
   const LbfgsMemory::InitialInverse initial = [&](const NodeVectorField& r, NodeVectorField& z) {
-    system_.apply_preconditioner(r, z);
+    system().apply_preconditioner(r, z);
     constraints.project(z);
   };
   // At most two tries: with the H₀ at hand, then (if it was built at an earlier iteration) with
@@ -284,7 +322,7 @@ bool NewtonSolver::lbfgs_direction_and_line_search(Step& step, const NodeVectorF
     {
       Teuchos::TimeMonitor t(cg_timer());
       const auto start = std::chrono::steady_clock::now();
-      lbfgs_.direction(gradient, dv, dot, initial, system_.unpreconditioned());
+      lbfgs_.direction(gradient, dv, dot, initial, system().unpreconditioned());
       constraints.project(dv);
       row.solve_seconds = seconds_since(start);
     }
@@ -292,7 +330,7 @@ bool NewtonSolver::lbfgs_direction_and_line_search(Step& step, const NodeVectorF
     row.iterations = 1;
     row.relative_residual = std::numeric_limits<double>::quiet_NaN();
     row.converged = true;
-    row.preconditioner = system_.label();
+    row.preconditioner = system().label();
     ++report.projected_solves;
     const double slope = dot(gradient, dv);
     if (slope < 0.0 && line_search(step, dv, slope)) {
@@ -332,7 +370,7 @@ bool NewtonSolver::line_search(Step& step, const NodeVectorField& dv, double slo
   if (accepted) {
     report.step_lengths.push_back(alpha);
     step.v.swap(step.v_trial);
-    rules_.line_search_step(alpha);
+    rules().line_search_step(alpha);
   }
   report.line_search_seconds += seconds_since(start);
   return accepted;

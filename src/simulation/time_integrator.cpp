@@ -14,6 +14,20 @@ namespace viscompm::simulation {
 
 namespace {
 Teuchos::RCP<Teuchos::Time> timer(const char* name) { return Teuchos::TimeMonitor::getNewCounter(name); }
+
+// One Newton system per configuration: the solver file's, or each of a measured choice's.
+std::vector<std::unique_ptr<linalg::NewtonSystem>> make_systems(const linalg::NodeSpace& space,
+                                                                const linalg::SolverConfiguration& solver) {
+  std::vector<std::unique_ptr<linalg::NewtonSystem>> systems;
+  if (!solver.is_choice()) systems.push_back(std::make_unique<linalg::NewtonSystem>(space, solver));
+  for (const auto& candidate : solver.candidates()) systems.push_back(std::make_unique<linalg::NewtonSystem>(space, candidate));
+  return systems;
+}
+std::vector<linalg::NewtonSystem*> pointers(const std::vector<std::unique_ptr<linalg::NewtonSystem>>& systems) {
+  std::vector<linalg::NewtonSystem*> out;
+  for (const auto& s : systems) out.push_back(s.get());
+  return out;
+}
 }  // namespace
 
 TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::GridGeometry& geometry,
@@ -26,8 +40,10 @@ TimeIntegrator::TimeIntegrator(const parallel::Communicator& comm, const grid::G
       materials_(materials),
       boundary_(boundary),
       space_(comm),
-      system_(space_, solver),
-      newton_(settings.newton, system_, comm) {
+      systems_(make_systems(space_, solver)),
+      newton_(solver.is_choice()
+                  ? newton::NewtonSolver(settings.newton, pointers(systems_), solver.choice(), comm)
+                  : newton::NewtonSolver(settings.newton, *systems_.front(), comm)) {
   layout_.geometry = geometry;
   layout_.order = order;
 }
@@ -160,7 +176,7 @@ bool TimeIntegrator::build_layout(particles::ParticleSet& particles, double dt) 
     partition_decomposition_ = decomposition_;
     ++partition_builds_;
     space_.update(*partition_);
-    system_.build_pattern();
+    newton_system().build_pattern();
     layout_.nodes = partition_->nodes();
     layout_.owned_count = partition_->owned_count();
   }

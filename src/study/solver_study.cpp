@@ -559,7 +559,10 @@ StudySettings read_study(const std::string& file, const std::vector<scene::Overr
   if (settings.solvers.empty()) throw parameter_error(file, "Solvers", "give at least one solver file");
   for (const auto& entry : settings.scenes)
     for (double h : entry.cell_sizes) (void)scene_at(entry, h);
-  for (const auto& s : settings.solvers) (void)linalg::SolverConfiguration::read(s);
+  for (const auto& s : settings.solvers)
+    if (linalg::SolverConfiguration::read(s).is_choice())
+      throw parameter_error(file, "Solvers", "'" + s + "' is a measured choice, which picks a configuration per time "
+                                             "step: a systems study solves each system with one (list its candidates)");
   return settings;
 }
 

@@ -241,12 +241,13 @@ TEST(SolverConfigurations, EverySpellingOfBlockRelaxationGivesTheSameSmoother) {
 
 namespace {
 // A shipped solver file with the string parameter `key` set to `value` at its top level.
-linalg::SolverConfiguration with_parameter(const std::string& name, const std::string& key, const std::string& value) {
+linalg::SolverConfiguration with_parameter(const std::string& name, const std::string& key, const std::string& value,
+                                           const std::string& type = "string") {
   std::ifstream in(solver_file(name));
   std::stringstream text;
   text << in.rdbuf();
   std::string xml = text.str();
-  const std::string element = "<Parameter name=\"" + key + "\" type=\"string\" value=\"" + value + "\"/>";
+  const std::string element = "<Parameter name=\"" + key + "\" type=\"" + type + "\" value=\"" + value + "\"/>";
   if (const std::size_t old = xml.find("<Parameter name=\"" + key + "\""); old != std::string::npos) {
     xml.replace(old, xml.find("/>", old) + 2 - old, element);
   } else {
@@ -290,6 +291,33 @@ TEST(SolverConfigurations, TheLeanCycleTakesTheIterationsOfMueLusCycle) {
   if (world.is_root())
     std::cout << "  stiff inclusions: MueLu cycle " << muelu_report.iterations << ", lean cycle "
               << lean_report.iterations << " iterations\n";
+}
+
+TEST(SolverConfigurations, TheLeanCycleOnAOneLevelHierarchyIsMueLusCoarseSolver) {
+  // A grid no larger than Coarsest nodes is one level, which MueLu solves with its coarse solver
+  // (the shaving foam's first steps on 2 ranks): the lean cycle has no level below to wrap, so
+  // it is MueLu's one-level preconditioner, and CG takes its iterations exactly.
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  auto one_level = [](const std::string& cycle) {
+    std::ifstream in(solver_file("gmg_lean_deflated_cg.xml"));
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string xml = text.str();
+    for (const auto& [key, value] : {std::pair<std::string, std::string>{"Coarsest nodes\" type=\"int\" value=\"", "100000000"},
+                                     {"Cycle\" type=\"string\" value=\"", cycle}}) {
+      const std::size_t at = xml.find(key) + key.size();
+      xml.replace(at, xml.find('"', at) - at, value);
+    }
+    return linalg::SolverConfiguration::from_xml(xml, "one level, Cycle = " + cycle);
+  };
+  StiffSystem lean(one_level("lean"), world), muelu(one_level("MueLu"), world);
+  lean.assemble(1.0 / 24.0);
+  muelu.assemble(1.0 / 24.0);
+  const auto lean_report = lean.solve(), muelu_report = muelu.solve();
+  ASSERT_TRUE(muelu_report.converged) << muelu_report.failure;
+  EXPECT_TRUE(lean_report.converged) << lean_report.failure;
+  EXPECT_LT(lean_report.relative_residual, 1e-5);
+  EXPECT_EQ(lean_report.iterations, muelu_report.iterations);
 }
 
 TEST(SolverConfigurations, TheDeflatedLeanCycleIsSymmetricPositiveDefinite) {
@@ -349,4 +377,40 @@ TEST(SolverConfigurations, DeflatingTheStiffBodiesCutsTheIterationsOnAnyRankCoun
   if (world.is_root())
     std::cout << "  stiff inclusions, lean cycle: " << plain.iterations << " iterations, deflated "
               << deflated.iterations << " (1 rank: " << reference[0] << ", " << reference[1] << ")\n";
+}
+
+TEST(SolverConfigurations, TheMeasuredChoiceTriesEveryCandidateAndAgreesWithThem) {
+  // inputs/solvers/measured_choice_cg.xml on the default scene, 24 steps: every Newton direction
+  // is computed by one candidate (the first two directions are its trial, one each), a later
+  // trial comes within the schedule, and the particles agree with a run of the paper's solver
+  // alone to Newton's tolerance (the choice changes the linear solver, not the step).
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const auto choice = linalg::SolverConfiguration::read(solver_file("measured_choice_cg.xml"));
+  ASSERT_TRUE(choice.is_choice());
+  ASSERT_EQ(choice.candidates().size(), 2u);
+  EXPECT_EQ(choice.candidates()[0].label(), linalg::SolverConfiguration::read(solver_file("matrix_free_jacobi_cg.xml")).label());
+  const auto scene = scene::read_scene(VISCOMPM_SOURCE_DIR "/inputs/scenes/shooting_sponge.xml",
+                                       {{"Newton/Tolerance", "1e-9"}, {"Simulation/Max time step", "2e-3"}});
+  auto run = [&](const linalg::SolverConfiguration& config) {
+    simulation::Simulation sim(scene, config, world);
+    simulation::RunSummary summary;
+    sim.advance_to(24 * 2e-3, summary);
+    EXPECT_EQ(summary.steps, 24);
+    if (const auto* state = sim.integrator().solver_choice()) {
+      EXPECT_EQ(state->systems()[0] + state->systems()[1], summary.newton_iterations);
+      EXPECT_GE(state->systems()[0], 1);
+      EXPECT_GE(state->systems()[1], 1);
+      EXPECT_GE(state->trials(), 2) << "a second trial after 16 systems of the chosen one";
+      if (world.is_root())
+        std::cout << "  measured choice: " << state->systems()[0] << " and " << state->systems()[1] << " systems, "
+                  << state->trials() << " trials\n";
+    }
+    return testkit::gather_particles(sim.particles(), world.comm());
+  };
+  const auto chosen = run(choice);
+  const auto paper = run(choice.candidates()[0]);
+  if (!world.is_root()) return;
+  const double difference = testkit::max_state_difference(chosen, paper);
+  EXPECT_LT(difference, 1e-6) << "positions and velocities of the choice's run against the paper solver's";
+  std::cout << "  measured choice, 24 steps: largest difference from the paper's solver " << difference << "\n";
 }

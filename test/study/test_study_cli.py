@@ -122,7 +122,8 @@ logged = [r for r in csv.DictReader(open(os.path.join(run_dir, "solver.csv")))
           if r["step"] == "2" and r["newton_iteration"] == "1"] if result.returncode == 0 else []
 mm_study = os.path.join(args.workdir, "mm.xml")
 assembled = ["jacobi_cg.xml"] + sorted(f for f in os.listdir(solvers)
-                                       if f.endswith(".xml") and f != "jacobi_cg.xml" and "matrix_free" not in f)
+                                       if f.endswith(".xml") and f != "jacobi_cg.xml" and "matrix_free" not in f
+                                       and "Choose between" not in open(os.path.join(solvers, f)).read())
 with open(mm_study, "w") as f:
     f.write(f"""<ParameterList name="mm">
   <Parameter name="Matrix Market files" type="Array(string)" value="{{{run_dir}/newton_step_2.mtx}}"/>
@@ -177,6 +178,7 @@ with open(mm_study) as f:
     mm_text = f.read()
 cases = [("a missing scene", [f"Scene={args.workdir}/no_such_scene.xml", "Cell sizes={0.06}"], mm_study, "'Scene'"),
          ("a missing solver file", [f"Solvers={{{solvers}/no_such_solver.xml}}"], mm_study, "'Solvers'"),
+         ("a measured choice of solvers", [f"Solvers={{{solvers}/measured_choice_cg.xml}}"], mm_study, "'Solvers'"),
          ("a missing MatrixMarket file", [f"Matrix Market files={{{cut}/none.mtx}}"], mm_study,
           "'Matrix Market files'"),
          ("a matrix cut short", [f"Matrix Market files={{{cut}/short.mtx}}"], os.path.join(cut, "short.mtx"),

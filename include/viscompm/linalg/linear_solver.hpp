@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace viscompm::linalg {
 
@@ -21,6 +22,16 @@ struct LinearSolveReport {
   std::string failure;             ///< why the Krylov solver stopped early (empty if it did not throw)
 };
 
+/// A measured choice between solver files (a solver file with `Choose between`): how its trials
+/// are scheduled, counted in Newton systems (newton::SolverChoice; doc/solvers.md).
+struct SolverChoiceSettings {
+  int trial_systems = 1;          ///< Newton systems each candidate solves in a trial
+  int recheck_systems = 16;       ///< systems of the chosen one before the next trial (doubled when confirmed)
+  int max_recheck_systems = 256;  ///< the longest interval between trials
+  double regime_change = 2.0;     ///< a trial at once when the chosen one's cost per system moves by this factor
+  int regime_systems = 4;         ///< systems after a trial before a regime change is looked for
+};
+
 class SolverConfiguration {
  public:
   /// Reads and validates a solver XML file. Throws InputError naming the file and parameter.
@@ -35,8 +46,13 @@ class SolverConfiguration {
   /// True for the matrix-free Hessian (Operator = matrix-free).
   bool matrix_free() const;
   /// Throws InputError (naming the file and 'Ranks') when a run on `ranks` ranks is more than the
-  /// file supports.
+  /// file supports (any candidate's, for a measured choice).
   void check_rank_count(int ranks) const;
+  /// A measured choice: the configurations it picks from, in the file's order (empty: this is one
+  /// configuration). Only time integration runs a choice; everything else takes one configuration.
+  const std::vector<SolverConfiguration>& candidates() const;
+  bool is_choice() const { return !candidates().empty(); }
+  const SolverChoiceSettings& choice() const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }

@@ -36,6 +36,8 @@ class NewtonSystem {
   /// reuse options allow). Returns the seconds it took. The caller decides when (newton::ReuseRules
   /// in a run): solve and apply_preconditioner never set it up themselves.
   double precondition();
+  /// Builds the pattern if the node space changed since it was built (collective); seconds.
+  double prepare();
   /// The NodeSpace version the pattern was built for.
   std::uint64_t pattern_version() const;
   /// True once precondition() has run for the current sparsity pattern.

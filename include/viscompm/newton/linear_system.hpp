@@ -28,6 +28,9 @@ class LinearSystem {
   virtual void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z) = 0;
   /// True if there is no preconditioner (apply_preconditioner is the identity).
   virtual bool unpreconditioned() const = 0;
+  /// Builds what the system needs on the current node space if it is not built yet (a measured
+  /// choice's candidate builds its Hessian's graph when it is first used on a partition); seconds.
+  virtual double prepare() { return 0.0; }
   /// Changes whenever the sparsity pattern is rebuilt.
   virtual std::uint64_t pattern_version() const = 0;
   /// The solver file's relative tolerance.

@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "viscompm/newton/linear_system.hpp"
 #include "viscompm/newton/newton_settings.hpp"
 #include "viscompm/newton/reuse_rules.hpp"
+#include "viscompm/newton/solver_choice.hpp"
 
 namespace viscompm::newton {
 
@@ -62,6 +64,10 @@ class NewtonSolver {
 
   /// On the simulation's system.
   NewtonSolver(const NewtonSettings& settings, linalg::NewtonSystem& system, const parallel::Communicator& comm);
+  /// On a measured choice's candidates: each Newton direction is computed with the one
+  /// SolverChoice names, timed for it (seconds per decade of residual reduction of its solve).
+  NewtonSolver(const NewtonSettings& settings, const std::vector<linalg::NewtonSystem*>& candidates,
+               const linalg::SolverChoiceSettings& choice, const parallel::Communicator& comm);
   /// On any system (tests); `system` must outlive the solver.
   NewtonSolver(const NewtonSettings& settings, LinearSystem& system, const parallel::Communicator& comm);
   ~NewtonSolver();
@@ -78,6 +84,10 @@ class NewtonSolver {
   /// request ends every rank's solve.
   void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
   const NewtonSettings& settings() const { return settings_; }
+  /// The candidate the next direction is computed with (0 without a measured choice).
+  int candidate() const { return current_; }
+  /// A measured choice's state (null for one system).
+  const SolverChoice* choice() const { return choice_ ? &*choice_ : nullptr; }
 
  private:
   struct Step;  // the state of one solve
@@ -101,12 +111,22 @@ class NewtonSolver {
   void assemble(Step& step, bool project);
   void precondition(Step& step);
 
+  /// Makes the choice's next candidate current for the next direction (its pattern built, its
+  /// rules begun for this step if they were not).
+  void select_candidate(Step& step);
+  LinearSystem& system() { return *systems_[current_]; }
+  const LinearSystem& system() const { return *systems_[current_]; }
+  ReuseRules& rules() { return rules_[current_]; }
+
   NewtonSettings settings_;
-  std::unique_ptr<LinearSystem> owned_system_;
-  LinearSystem& system_;
+  std::vector<std::unique_ptr<LinearSystem>> owned_systems_;
+  std::vector<LinearSystem*> systems_;  ///< one, or a measured choice's candidates
   parallel::Communicator comm_;
   std::function<bool()> interrupt_;
-  ReuseRules rules_;
+  std::vector<ReuseRules> rules_;       ///< per system: what it keeps
+  std::vector<bool> begun_;             ///< per system: its rules began this step's solve
+  int current_ = 0;
+  std::optional<SolverChoice> choice_;
   LbfgsMemory lbfgs_;
 };
 

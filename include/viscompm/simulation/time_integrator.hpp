@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "viscompm/boundary/colliders.hpp"
@@ -112,9 +113,12 @@ class TimeIntegrator {
   /// next step rebuilds the node partition.
   void set_decomposition(const parallel::Decomposition& decomposition) { decomposition_ = &decomposition; }
   const grid::GridLayout& layout() const { return layout_; }
-  linalg::NewtonSystem& newton_system() { return system_; }
+  /// The system the next Newton direction is computed with (a measured choice's next candidate).
+  linalg::NewtonSystem& newton_system() { return *systems_[newton_.candidate()]; }
   /// Newton's solve ends early (the step is not taken) when `requested` is true on any rank.
   void set_interrupt(std::function<bool()> requested) { newton_.set_interrupt(std::move(requested)); }
+  /// A measured choice's state (null for one solver configuration).
+  const newton::SolverChoice* solver_choice() const { return newton_.choice(); }
   linalg::NodeSpace& node_space() { return space_; }
   /// How many times the node partition has been built.
   int partition_builds() const { return partition_builds_; }
@@ -133,7 +137,9 @@ class TimeIntegrator {
   const parallel::Decomposition* partition_decomposition_ = nullptr;  // the decomposition it was built for
   int partition_builds_ = 0;
   linalg::NodeSpace space_;
-  linalg::NewtonSystem system_;
+  // One Newton system per solver configuration: one, or a measured choice's candidates (each
+  // builds its Hessian's graph when it is first used on a partition).
+  std::vector<std::unique_ptr<linalg::NewtonSystem>> systems_;
   newton::NewtonSolver newton_;
   NodeScalarField mass_;
   NodeVectorField momentum_, v_old_;
