@@ -4,12 +4,15 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/core/shape.hpp"
+#include "viscompm/core/stop_request.hpp"
 #include "viscompm/geometry/level_set.hpp"
+#include "viscompm/materials/shared_parameters.hpp"
 #include "viscompm/parallel/communicator.hpp"
 #include "viscompm/params/parameter_io.hpp"
 #include "default_solver_xml.hpp"  // generated: cmake/viscompmDefaultSolver.cmake
@@ -599,7 +602,12 @@ constexpr double max_stiffness_ratio = 1.0 / std::numeric_limits<double>::epsilo
 //   CFL condition on that speed asks for Δt ≤ CFL·Δx / (g·Δt_min): beyond g = CFL·Δx / Δt_min² no
 //   step can be taken;
 // - elasticity: a material's P-wave modulus λ + 2μ against its inertia in one step,
-//   (λ + 2μ)·Δt² / (ρ·Δx²) = (c·Δt/Δx)², beyond max_stiffness_ratio at Δt = Min time step.
+//   (λ + 2μ)·Δt² / (ρ·Δx²) = (c·Δt/Δx)², beyond max_stiffness_ratio at Δt = Min time step;
+// - viscosity: the Newtonian term's Hessian, 2·c_N·V/Δx² per node (c_N the coefficient of
+//   Φ^N = c_N ε̂:ε̂ V, ε̂ = sym(A)/Δt), against the mass ρ·V: the viscous diffusion number
+//   η·Δt/(ρ·Δx²) = ν·Δt/Δx² (η = c_N/Δt whichever the convention), beyond max_stiffness_ratio at
+//   Δt = Min time step — the smallest it can be (c_N = Δt·η grows with Δt; the paper's μ^N does
+//   not depend on it).
 void check_physical_bounds(const SceneConfig& scene) {
   const double dx = scene.grid.cell_size, dt = scene.simulation.min_time_step;
   const double g = scene.simulation.gravity.stableNorm();  // no overflow: 1e300 stays 1e300
@@ -624,6 +632,21 @@ void check_physical_bounds(const SceneConfig& scene) {
            << max_stiffness_ratio << "), at every Δt the scene allows";
     throw parameter_error(scene.file, "Materials/" + m.name + (lambda > 2.0 * mu ? "/Lame lambda" : "/Shear modulus"),
                           reason.str());
+  }
+  for (const auto& m : scene.materials) {
+    if (!m.entry || !m.values.has("Density") || !m.values.has("Newtonian viscosity")) continue;
+    ParameterTable<materials::NewtonianParameters> newtonian;
+    materials::add_newtonian_parameters(newtonian);
+    const materials::NewtonianParameters viscous = newtonian.parse(m.values);
+    const double c_n = materials::viscous_coefficient(viscous.viscosity_convention, viscous.newtonian_viscosity, dt);
+    const double number = c_n / (m.values.real("Density") * dx * dx);
+    if (number <= max_stiffness_ratio) continue;
+    std::ostringstream reason;
+    reason.precision(3);
+    reason << "the viscous diffusion number η·Δt/(ρ·Δx²) = " << number << " at Simulation/Min time step (" << dt
+           << " s): the material's viscosity exceeds its inertia in a step by more than double precision holds ("
+           << max_stiffness_ratio << "), at every Δt the scene allows";
+    throw parameter_error(scene.file, "Materials/" + m.name + "/Newtonian viscosity", reason.str());
   }
 }
 
