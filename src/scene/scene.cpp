@@ -705,9 +705,7 @@ void check_keyframes(const ColliderSettings& c, const std::string& file, const s
 }
 
 // The fastest motion a scene prescribes, and the parameter that sets it.
-struct FastestMotion {
-  double speed = 0.0;
-  std::string parameter;
+struct FastestMotion : PrescribedMotion {
   void consider(double s, const std::string& path) {
     if (s > speed) {
       speed = s;
@@ -746,9 +744,14 @@ FastestMotion fastest_motion(const SceneConfig& scene) {
   return fastest;
 }
 
+}  // namespace
+
+PrescribedMotion fastest_prescribed_motion(const SceneConfig& scene) { return fastest_motion(scene); }
+
+namespace {
 // Δt follows the fastest motion (CFL); below Min time step a run could not take a step.
 void check_speeds(const SceneConfig& scene) {
-  const FastestMotion fastest = fastest_motion(scene);
+  const PrescribedMotion fastest = fastest_prescribed_motion(scene);
   if (!(fastest.speed > 0.0)) return;
   const double dt = scene.simulation.cfl * scene.grid.cell_size / fastest.speed;
   if (std::isfinite(fastest.speed) && dt >= scene.simulation.min_time_step) return;

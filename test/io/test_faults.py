@@ -5,6 +5,7 @@
 - The disk fills during the run (a small tmpfs, else a file-size limit): exit 3 with one line,
   every file written before intact, nothing half-written left.
 - The output directory disappears during the run: exit 3, the earlier frames intact.
+- A collider spun faster than the material's elastic waves: exit 3 naming its Angular velocity.
 - A truncated, foreign or corrupted checkpoint: exit 2 with one line naming it."""
 import glob
 import os
@@ -180,6 +181,19 @@ check(process.returncode == 3, f"vanishing directory: exit 3, got {process.retur
 check(len(our_lines(stderr)) == 1, f"vanishing directory: one line: {our_lines(stderr)}")
 kept = sorted(glob.glob(os.path.join(out + ".moved", "frame_*.h5")))
 check(len(kept) >= 3 and all(readable(p) for p in kept), f"vanishing directory: earlier frames intact: {kept}")
+
+# A sticky grip spun far faster than any elastic wave of the sponge it twists (issue 24): no
+# read-time bound holds (every step resolves the motion: the CFL step follows the rim's speed), so
+# the run fails at the smallest Δt — exit 3, one line naming the parameter behind it.
+spun = subprocess.run(shlex.split(args.mpiexec) + ["-np", str(args.ranks), args.viscompm,
+                                                   os.path.join(args.inputs, "scenes", "paper", "twisting_sponge.xml"),
+                                                   "--frames", "1", "--output", os.path.join(args.workdir, "spun"),
+                                                   "--set", "Colliders/top grip/Angular velocity={0, 1e4, 0}"],
+                      capture_output=True, text=True, timeout=300)
+lines = our_lines(spun.stderr)
+check(spun.returncode == 3, f"spun grip: exit 3, got {spun.returncode}: {spun.stderr[-400:]}")
+check(len(lines) == 1 and "'Colliders/top grip/Angular velocity'" in lines[0],
+      f"spun grip: one line naming the angular velocity: {lines}")
 
 # Checkpoints that cannot be restarted from: exit 2, one line naming the file.
 bad = os.path.join(args.workdir, "bad_checkpoints")

@@ -170,6 +170,15 @@ Shape shape_of(const ShapeSettings& settings);
 /// The collider a scene describes: its shape, contact, rigid motion and surface velocity.
 boundary::Collider collider_of(const ColliderSettings& settings);
 
+/// The fastest motion a scene prescribes — a body's initial velocity and rotation, a collider's
+/// translation, rotation at its farthest point, keyframes and surface velocity, an emitter's
+/// velocity — and the parameter that sets it ("Colliders/<name>/Angular velocity"); speed 0 if none.
+struct PrescribedMotion {
+  double speed = 0.0;  ///< [m/s]
+  std::string parameter;
+};
+PrescribedMotion fastest_prescribed_motion(const SceneConfig& scene);
+
 /// A --set override: "Path/To/Parameter=value".
 struct Override {
   std::string path;
