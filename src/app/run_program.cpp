@@ -57,7 +57,7 @@ int run_simulation_program(int argc, char** argv) {
       if (root) std::cout << cl.help_text;
       return exit_success;
     }
-    const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
+    const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides, comm);
     const linalg::SolverConfiguration solver = scene::solver_configuration(scene);
     simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);

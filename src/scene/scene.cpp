@@ -546,13 +546,33 @@ void load_mesh(ShapeSettings& s, const std::string& file, const std::string& pat
   s.field = std::make_shared<geometry::LevelSet>(mesh, voxel);
 }
 
+// How the ranks reading a scene together agree on a stop request: given this rank's signal (0:
+// none), the largest of all ranks' (collective), or this rank's alone when it reads by itself.
+using StopAgreement = std::function<int(int)>;
+
+// One mesh's level set, a stage of reading: a stop request that ended this rank's build (or
+// came before its end) is agreed with the other ranks after the stage, so that every rank throws
+// StopRequested together or none does — none goes on to a collective the others have left.
+// (The checks before the build, which may throw InputError, read the same files on every rank.)
+void load_mesh_stage(ShapeSettings& s, const std::string& file, const std::string& path, double cell_size,
+                     bool must_be_closed, const StopAgreement& agree) {
+  if (s.shape != ShapeKind::mesh) return;
+  int signal = 0;
+  try {
+    load_mesh(s, file, path, cell_size, must_be_closed);
+  } catch (const StopRequested& e) {
+    signal = e.signal;
+  }
+  if (const int agreed = agree(std::max(signal, stop_signal()))) throw StopRequested(agreed);
+}
+
 // Meshes' level sets (voxels default to a quarter cell) and disc nozzles (two cells along the
 // velocity): after every override, so that a changed cell size reaches them.
-void derive_from_cell_size(SceneConfig& scene) {
+void derive_from_cell_size(SceneConfig& scene, const StopAgreement& agree) {
   const double dx = scene.grid.cell_size;
-  for (auto& b : scene.bodies) load_mesh(b, scene.file, "Bodies/" + b.name, dx, true);
-  for (auto& c : scene.colliders) load_mesh(c, scene.file, "Colliders/" + c.name, dx, false);
-  for (auto& r : scene.regions) load_mesh(r, scene.file, "Regions/" + r.name, dx, true);
+  for (auto& b : scene.bodies) load_mesh_stage(b, scene.file, "Bodies/" + b.name, dx, true, agree);
+  for (auto& c : scene.colliders) load_mesh_stage(c, scene.file, "Colliders/" + c.name, dx, false, agree);
+  for (auto& r : scene.regions) load_mesh_stage(r, scene.file, "Regions/" + r.name, dx, true, agree);
   for (auto& e : scene.emitters)
     if (e.shape == ShapeKind::disc) {
       e.axis = e.velocity;
@@ -810,7 +830,9 @@ void check_shapes_and_speeds(const SceneConfig& scene) {
 }
 }  // namespace
 
-SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides) {
+namespace {
+SceneConfig read_scene_in_stages(const std::string& file, const std::vector<Override>& overrides,
+                                 const StopAgreement& agree) {
   auto root = read_xml_file(file);
   for (const auto& o : overrides) apply_override(*root, o, file);
 
@@ -826,8 +848,23 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   check_grid_and_time_steps(scene);
   check_physical_bounds(scene);
   check_settings(scene);
-  derive_from_cell_size(scene);  // meshes: the only part of reading that may take long
+  derive_from_cell_size(scene, agree);  // meshes: the only part of reading that may take long
   check_shapes_and_speeds(scene);
+  return scene;
+}
+}  // namespace
+
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides) {
+  return read_scene_in_stages(file, overrides, [](int signal) { return signal; });
+}
+
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides,
+                       const parallel::Communicator& comm) {
+  const StopAgreement agree = [&comm](int signal) { return static_cast<int>(comm.max(std::int64_t{signal})); };
+  SceneConfig scene = read_scene_in_stages(file, overrides, agree);
+  // The last stage: a request that came while the scene was read is agreed before the run's
+  // first collective.
+  if (const int agreed = agree(stop_signal())) throw StopRequested(agreed);
   return scene;
 }
 

@@ -236,3 +236,30 @@ TEST(NonFiniteSteps, EndTheRunWithTheFramesWrittenSoFarIntact) {
   for (std::size_t p = 0; p < frame0.size(); ++p) finite &= frame0.deformation_gradient[p].allFinite();
   EXPECT_FALSE(world.any(!finite));
 }
+
+// Issue 24: a stop request that reaches one rank while the scene's meshes are read (a mesh's level
+// set, the long part of setting a run up) ends reading on every rank at the same stage, with
+// StopRequested: no rank goes on to the run's first collective to wait there for one that left
+// (it used to: the signalled rank ended, the others hung until killed).
+TEST(StopRequest, DuringAMeshsLevelSetReachesEveryRankBeforeTheNextCollective) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string toothpaste = VISCOMPM_SOURCE_DIR "/inputs/scenes/paper/toothpaste.xml";
+  const std::vector<scene::Override> coarse = {{"Colliders/toothbrush/Voxel size", "0.02"}};
+  install_stop_handlers();
+  clear_stop_signal();
+  if (world.rank() == world.size() - 1) std::raise(SIGUSR1);
+  int stopped = 0;
+  try {
+    (void)scene::read_scene(toothpaste, coarse, world);
+  } catch (const StopRequested& e) {
+    stopped = e.signal;
+  }
+  clear_stop_signal();
+  EXPECT_EQ(stopped, SIGUSR1) << "rank " << world.rank() << " did not stop with the others";
+  // Every rank is here, at the same collective; without a request the same reading completes.
+  EXPECT_EQ(world.sum(std::int64_t{stopped != 0}), world.size());
+  scene::SceneConfig scene;
+  EXPECT_NO_THROW(scene = scene::read_scene(toothpaste, coarse, world));
+  ASSERT_EQ(scene.colliders.size(), 1u);
+  EXPECT_TRUE(scene.colliders[0].field != nullptr);
+}
