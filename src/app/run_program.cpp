@@ -24,10 +24,11 @@ int run_with_exit_codes(const std::string& program, const parallel::Communicator
     if (comm.is_root()) std::cerr << program << ": failed: " << e.what() << std::endl;
     return exit_simulation_failed;
   } catch (const StopRequested& e) {
-    // While the run was set up: nothing simulated, nothing to continue from.
+    // While the run was set up or wrote frame 0 (every rank agreed): nothing simulated, nothing
+    // to continue from.
     if (comm.is_root())
       std::cerr << program << ": stopped by signal " << e.signal << " (" << strsignal(e.signal)
-              << ") while the run was set up; nothing was simulated" << std::endl;
+                << ") before the first step, while the run was set up; nothing was simulated" << std::endl;
     return exit_interrupted;
   } catch (const std::exception& e) {
     std::cerr << program << ": internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
