@@ -2,6 +2,7 @@
 """What a batch system does to a run, end to end (doc/contracts.md, "Stopping, failing, restarting"):
 - SIGTERM to one rank only, SIGINT to another, SIGUSR1 to mpiexec: exit 4 after a checkpoint,
   one message; --restart continues to the frames of an uninterrupted run, bit for bit.
+- SIGUSR1 to one rank only while a mesh's level set is built: every rank stops, exit 4.
 - The disk fills during the run (a small tmpfs, else a file-size limit): exit 3 with one line,
   every file written before intact, nothing half-written left.
 - The output directory disappears during the run: exit 3, the earlier frames intact.
@@ -132,6 +133,51 @@ for name, how in [("sigterm_one_rank", "term"), ("sigint_rank0", "int"), ("sigus
             check(same, f"{name}: the restarted run ends bit for bit where the uninterrupted one does")
         grids = ET.parse(os.path.join(out, "particles.xdmf")).getroot().findall("./Domain/Grid[@Name='particles']/Grid")
         check(len(grids) == frames + 1, f"{name}: the XDMF index lists every frame once: {len(grids)}")
+
+# Issue 24: SIGUSR1 to the last rank only while the ranks build a mesh's level set (the toothbrush
+# at fine voxels: seconds), as soon as its handler is installed. Every rank agrees on the request
+# after that stage: exit 4 with one line saying nothing was simulated, no frame written, within a
+# minute. (The signalled rank used to leave alone and the others to wait at the run's first
+# collective until killed.)
+def catches(pid, signum):
+    """Whether process `pid` has installed a handler for `signum` (/proc/PID/status, SigCgt)."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("SigCgt:"):
+                    return bool(int(line.split()[1], 16) >> (signum - 1) & 1)
+    except OSError:
+        pass
+    return False
+
+
+out = os.path.join(args.workdir, "stop_during_level_set")
+toothpaste = os.path.join(args.inputs, "scenes", "paper", "toothpaste.xml")
+process = subprocess.Popen(shlex.split(args.mpiexec) + ["-np", str(args.ranks), args.viscompm, toothpaste, "--frames", "1",
+                                                        "--output", out, "--set", "Colliders/toothbrush/Voxel size=0.0007"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+deadline = time.time() + 30
+ranks = []
+while time.time() < deadline and process.poll() is None:
+    ranks = ranks_of(process)
+    if len(ranks) == args.ranks and all(catches(pid, signal.SIGUSR1) for pid in ranks):
+        break
+    time.sleep(0.01)
+check(len(ranks) == args.ranks, f"stop during a level set: found the {args.ranks} ranks: {ranks}")
+if ranks:
+    os.kill(ranks[-1], signal.SIGUSR1)
+try:
+    stdout, stderr = process.communicate(timeout=60)
+except subprocess.TimeoutExpired:
+    for pid in ranks_of(process):
+        os.kill(pid, signal.SIGKILL)
+    os.killpg(process.pid, signal.SIGKILL)
+    stdout, stderr = process.communicate()
+    check(False, "stop during a level set: the ranks not signalled were left waiting (killed after 60 s)")
+check(process.returncode == 4, f"stop during a level set: exit 4, got {process.returncode}: {stderr[-500:]}")
+lines = our_lines(stderr)
+check(len(lines) == 1 and "nothing was simulated" in lines[0], f"stop during a level set: one line: {lines}")
+check(not glob.glob(os.path.join(out, "frame_*")), "stop during a level set: no frame written")
 
 # The disk fills: a tmpfs that holds frame 0, its checkpoint and frame 1, not more.
 frame_bytes = os.path.getsize(os.path.join(reference_dir, "frame_00000.h5"))
