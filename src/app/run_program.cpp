@@ -24,10 +24,11 @@ int run_with_exit_codes(const std::string& program, const parallel::Communicator
     if (comm.is_root()) std::cerr << program << ": failed: " << e.what() << std::endl;
     return exit_simulation_failed;
   } catch (const StopRequested& e) {
-    // While the run was set up: nothing simulated, nothing to continue from.
+    // While the run was set up or wrote frame 0 (every rank agreed): nothing simulated, nothing
+    // to continue from.
     if (comm.is_root())
       std::cerr << program << ": stopped by signal " << e.signal << " (" << strsignal(e.signal)
-              << ") while the run was set up; nothing was simulated" << std::endl;
+                << ") before the first step, while the run was set up; nothing was simulated" << std::endl;
     return exit_interrupted;
   } catch (const std::exception& e) {
     std::cerr << program << ": internal error on rank " << comm.rank() << ": " << e.what() << std::endl;
@@ -57,7 +58,7 @@ int run_simulation_program(int argc, char** argv) {
       if (root) std::cout << cl.help_text;
       return exit_success;
     }
-    const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides);
+    const scene::SceneConfig scene = scene::read_scene(cl.input_file, cl.overrides, comm);
     const linalg::SolverConfiguration solver = scene::solver_configuration(scene);
     simulation::Simulation simulation(scene, solver, comm, cl.restart_file);
     const simulation::RunSummary summary = simulation.run(std::cout);

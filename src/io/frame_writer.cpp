@@ -21,7 +21,7 @@ std::string frame_file_name(int frame) {
 
 FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
                       const materials::MaterialList& materials, const parallel::Communicator& comm,
-                      const FrameExtras& extras) {
+                      const FrameExtras& extras, const WritePieces& pieces) {
   FileAttributes attributes;
   attributes.reals["time"] = info.time;
   attributes.integers["step"] = info.step;
@@ -42,7 +42,7 @@ FrameInfo write_frame(const std::string& directory, FrameInfo info, const partic
   }
   attributes.reals["emitted_mass"] = extras.emitted_mass;
   info.particle_count = write_particle_file((std::filesystem::path(directory) / frame_file_name(info.frame)).string(),
-                                            attributes, particles, derived, material_names(materials), comm, tables);
+                                            attributes, particles, derived, material_names(materials), comm, tables, pieces);
   return info;
 }
 

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <type_traits>
 
@@ -67,34 +68,63 @@ void unflatten(const std::vector<double>& flat, std::vector<T>& field) {
   }
 }
 
-// Creates dataset `name` of n_total rows and writes this rank's rows at `offset` (collective).
-template <class D>
-void write_rows(WriteStatus& status, hid_t group, const std::string& name, hid_t type, const std::vector<D>& data,
-                const std::vector<hsize_t>& shape, hsize_t n_local, hsize_t offset, hsize_t n_total) {
-  std::vector<hsize_t> dims = {n_total}, start = {offset}, count = {n_local};
-  for (hsize_t d : shape) {
-    dims.push_back(d);
-    start.push_back(0);
-    count.push_back(d);
-  }
+// Creates dataset `name` of n_total rows and writes this rank's n_local rows at `offset` in
+// `pieces` collective writes of at most `piece_rows` rows each — the same number on every rank; a
+// rank whose rows are all written writes nothing in the later ones. `rows(first, count)` gives a
+// pointer to rows [first, first + count) of this rank, flattened; after each piece `go_on()`
+// (collective) says whether to continue.
+template <class Rows, class GoOn>
+void write_pieces(WriteStatus& status, hid_t group, const std::string& name, hid_t type,
+                  const std::vector<hsize_t>& shape, hsize_t n_local, hsize_t offset, hsize_t n_total,
+                  hsize_t piece_rows, hsize_t pieces, Rows rows, GoOn go_on) {
+  std::vector<hsize_t> dims = {n_total};
+  for (hsize_t d : shape) dims.push_back(d);
   const int rank = static_cast<int>(dims.size());
   const hid_t file_space = H5Screate_simple(rank, dims.data(), nullptr);
   const hid_t dataset = H5Dcreate2(group, name.c_str(), type, file_space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   status.check(dataset, "create dataset " + name);
-  const hid_t memory_space = H5Screate_simple(rank, count.data(), nullptr);
-  if (n_local > 0) {
-    status.check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), name);
-  } else {
-    H5Sselect_none(file_space);
-    H5Sselect_none(memory_space);
-  }
   const hid_t transfer = H5Pcreate(H5P_DATASET_XFER);
   H5Pset_dxpl_mpio(transfer, H5FD_MPIO_COLLECTIVE);
-  status.check(H5Dwrite(dataset, type, memory_space, file_space, transfer, data.data()), "write " + name);
+  for (hsize_t k = 0; k < pieces; ++k) {
+    const hsize_t first = std::min(n_local, k * piece_rows), count = std::min(n_local - first, piece_rows);
+    std::vector<hsize_t> start = {offset + first}, counts = {count};
+    for (hsize_t d : shape) {
+      start.push_back(0);
+      counts.push_back(d);
+    }
+    const hid_t memory_space = H5Screate_simple(rank, counts.data(), nullptr);
+    if (count > 0) {
+      status.check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, counts.data(), nullptr), name);
+    } else {
+      H5Sselect_none(file_space);
+      H5Sselect_none(memory_space);
+    }
+    status.check(H5Dwrite(dataset, type, memory_space, file_space, transfer, rows(first, count)), "write " + name);
+    H5Sclose(memory_space);
+    if (!go_on()) break;
+  }
   H5Pclose(transfer);
-  H5Sclose(memory_space);
   status.check(H5Dclose(dataset), "close " + name);
   H5Sclose(file_space);
+}
+
+// A small dataset in one piece (root arrays, tables): no agreement inside it.
+template <class D>
+void write_rows(WriteStatus& status, hid_t group, const std::string& name, hid_t type, const std::vector<D>& data,
+                const std::vector<hsize_t>& shape, hsize_t n_local, hsize_t offset, hsize_t n_total) {
+  write_pieces(status, group, name, type, shape, n_local, offset, n_total, n_local, 1,
+               [&](hsize_t, hsize_t) { return data.data(); }, [] { return true; });
+}
+
+// Rows [first, first + count) of a field, flattened (row-major) for Vec3 and Mat3.
+template <class T>
+const void* field_rows(const std::vector<T>& field, hsize_t first, hsize_t count, std::vector<double>& buffer) {
+  if constexpr (std::is_same_v<T, Vec3> || std::is_same_v<T, Mat3>) {
+    buffer = flatten(std::vector<T>(field.begin() + first, field.begin() + first + count));
+    return buffer.data();
+  } else {
+    return field.data() + first;
+  }
 }
 
 // Reads rows [offset, offset + n_local) of dataset `name` (collective).
@@ -183,32 +213,59 @@ herr_t collect_attribute(hid_t location, const char* name, const H5A_info_t*, vo
 }  // namespace
 
 namespace {
+// Where a collective write stands: the ranks agree after every piece whether a write failed on
+// any of them or any asks to stop (WritePieces::stop), in one collective.
+struct Progress {
+  const parallel::Communicator& comm;
+  const WritePieces& pieces;
+  const WriteStatus& status;
+  int stop_signal = 0;     ///< agreed: the largest signal asked for, 0 if none
+  bool abandoned = false;  ///< agreed: a write failed or a stop was asked for
+  bool go_on() {
+    const std::vector<std::int64_t> all =
+        comm.max(std::vector<std::int64_t>{status.failed.empty() ? 0 : 1, pieces.stop ? pieces.stop() : 0});
+    stop_signal = static_cast<int>(all[1]);
+    abandoned = all[0] != 0 || all[1] != 0;
+    return !abandoned;
+  }
+};
+
 // Every stored field and the derived tensors under /particles, this rank's rows at `start`
-// (collective). After each dataset the ranks agree whether to go on, so that no rank enters a
-// collective write the others have abandoned; returns true if abandoned.
+// (collective), in pieces of at most WritePieces::rows rows per rank. After each piece the ranks
+// agree whether to go on (Progress), so that no rank enters a collective write the others have
+// abandoned; returns true if abandoned.
 bool write_particles(WriteStatus& status, hid_t file, const particles::ParticleSet& particles,
                      const std::vector<DerivedTensor>& derived, const std::string& material_names,
-                     const parallel::Communicator& comm, hsize_t start, hsize_t total) {
+                     const parallel::Communicator& comm, hsize_t start, hsize_t total, Progress& progress) {
   const hid_t group = H5Gcreate2(file, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   status.check(group, "create /particles");
   const auto rows = static_cast<hsize_t>(particles.size());
-  bool abandoned = comm.any(!status.failed.empty());
+  const auto piece_rows = static_cast<hsize_t>(std::max<std::int64_t>(progress.pieces.rows, 1));
+  const auto pieces = static_cast<hsize_t>(std::max<std::int64_t>(
+      comm.max(static_cast<std::int64_t>((rows + piece_rows - 1) / piece_rows)), 1));
+  const auto go_on = [&] { return progress.go_on(); };
+  progress.go_on();
+  std::vector<double> buffer;
   particles.for_each_field([&](const char* name, const auto& field) {
     using T = typename std::decay_t<decltype(field)>::value_type;
-    if (abandoned) return;
-    write_rows(status, group, name, memory_type<T>(), flatten(field), row_shape<T>(), rows, start, total);
-    abandoned = comm.any(!status.failed.empty());
+    if (progress.abandoned) return;
+    write_pieces(status, group, name, memory_type<T>(), row_shape<T>(), rows, start, total, piece_rows, pieces,
+                 [&](hsize_t first, hsize_t count) { return field_rows(field, first, count, buffer); }, go_on);
   });
   for (const auto& d : derived) {
-    if (abandoned) break;
-    std::vector<Mat3> values(particles.size());
-    for (std::size_t p = 0; p < values.size(); ++p) values[p] = d.value(p);
-    write_rows(status, group, d.name, H5T_NATIVE_DOUBLE, flatten(values), {3, 3}, rows, start, total);
-    abandoned = comm.any(!status.failed.empty());
+    if (progress.abandoned) break;
+    write_pieces(status, group, d.name, H5T_NATIVE_DOUBLE, {3, 3}, rows, start, total, piece_rows, pieces,
+                 [&](hsize_t first, hsize_t count) {
+                   std::vector<Mat3> values(count);
+                   for (hsize_t p = 0; p < count; ++p) values[p] = d.value(first + p);
+                   buffer = flatten(values);
+                   return static_cast<const void*>(buffer.data());
+                 },
+                 go_on);
   }
   write_string_attribute(status, group, "material_names", material_names);
   status.check(H5Gclose(group), "close /particles");
-  return abandoned;
+  return progress.abandoned;
 }
 
 // The tables, rows from rank 0 (collective creation); a table of one column is a vector (m), of
@@ -243,7 +300,7 @@ void write_tables(WriteStatus& status, hid_t file, const std::vector<Table>& tab
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
                                  const std::string& material_names, const parallel::Communicator& comm,
-                                 const std::vector<Table>& tables) {
+                                 const std::vector<Table>& tables, const WritePieces& pieces) {
   const std::string temporary = path + ".tmp";
   const auto n_local = static_cast<long long>(particles.size());
   long long offset = 0, n_total = 0;
@@ -264,10 +321,20 @@ std::int64_t write_particle_file(const std::string& path, const FileAttributes& 
   for (const auto& [name, value] : attributes.strings) write_string_attribute(status, file, name, value);
   for (const auto& [name, values] : attributes.real_arrays)
     write_rows(status, file, name, H5T_NATIVE_DOUBLE, values, {}, comm.is_root() ? values.size() : 0, 0, values.size());
+  Progress progress{comm, pieces, status};
   const bool abandoned = write_particles(status, file, particles, derived, material_names, comm,
-                                         static_cast<hsize_t>(offset), static_cast<hsize_t>(n_total));
+                                         static_cast<hsize_t>(offset), static_cast<hsize_t>(n_total), progress);
   write_tables(status, file, tables, comm, abandoned);
   status.check(H5Fclose(file), "close");
+  // A stop asked for between pieces (and no failure): the partial file goes, every rank stops.
+  if (progress.stop_signal != 0 && !comm.any(!status.failed.empty())) {
+    if (comm.is_root()) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+    }
+    comm.barrier();
+    throw StopRequested(progress.stop_signal);
+  }
   // Every rank learns whether any failed; the file becomes visible only when complete.
   std::string failure;
   if (comm.any(!status.failed.empty())) {

@@ -4,12 +4,15 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <sstream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/core/shape.hpp"
+#include "viscompm/core/stop_request.hpp"
 #include "viscompm/geometry/level_set.hpp"
+#include "viscompm/materials/shared_parameters.hpp"
 #include "viscompm/parallel/communicator.hpp"
 #include "viscompm/params/parameter_io.hpp"
 #include "default_solver_xml.hpp"  // generated: cmake/viscompmDefaultSolver.cmake
@@ -543,13 +546,33 @@ void load_mesh(ShapeSettings& s, const std::string& file, const std::string& pat
   s.field = std::make_shared<geometry::LevelSet>(mesh, voxel);
 }
 
+// How the ranks reading a scene together agree on a stop request: given this rank's signal (0:
+// none), the largest of all ranks' (collective), or this rank's alone when it reads by itself.
+using StopAgreement = std::function<int(int)>;
+
+// One mesh's level set, a stage of reading: a stop request that ended this rank's build (or
+// came before its end) is agreed with the other ranks after the stage, so that every rank throws
+// StopRequested together or none does — none goes on to a collective the others have left.
+// (The checks before the build, which may throw InputError, read the same files on every rank.)
+void load_mesh_stage(ShapeSettings& s, const std::string& file, const std::string& path, double cell_size,
+                     bool must_be_closed, const StopAgreement& agree) {
+  if (s.shape != ShapeKind::mesh) return;
+  int signal = 0;
+  try {
+    load_mesh(s, file, path, cell_size, must_be_closed);
+  } catch (const StopRequested& e) {
+    signal = e.signal;
+  }
+  if (const int agreed = agree(std::max(signal, stop_signal()))) throw StopRequested(agreed);
+}
+
 // Meshes' level sets (voxels default to a quarter cell) and disc nozzles (two cells along the
 // velocity): after every override, so that a changed cell size reaches them.
-void derive_from_cell_size(SceneConfig& scene) {
+void derive_from_cell_size(SceneConfig& scene, const StopAgreement& agree) {
   const double dx = scene.grid.cell_size;
-  for (auto& b : scene.bodies) load_mesh(b, scene.file, "Bodies/" + b.name, dx, true);
-  for (auto& c : scene.colliders) load_mesh(c, scene.file, "Colliders/" + c.name, dx, false);
-  for (auto& r : scene.regions) load_mesh(r, scene.file, "Regions/" + r.name, dx, true);
+  for (auto& b : scene.bodies) load_mesh_stage(b, scene.file, "Bodies/" + b.name, dx, true, agree);
+  for (auto& c : scene.colliders) load_mesh_stage(c, scene.file, "Colliders/" + c.name, dx, false, agree);
+  for (auto& r : scene.regions) load_mesh_stage(r, scene.file, "Regions/" + r.name, dx, true, agree);
   for (auto& e : scene.emitters)
     if (e.shape == ShapeKind::disc) {
       e.axis = e.velocity;
@@ -599,7 +622,12 @@ constexpr double max_stiffness_ratio = 1.0 / std::numeric_limits<double>::epsilo
 //   CFL condition on that speed asks for Δt ≤ CFL·Δx / (g·Δt_min): beyond g = CFL·Δx / Δt_min² no
 //   step can be taken;
 // - elasticity: a material's P-wave modulus λ + 2μ against its inertia in one step,
-//   (λ + 2μ)·Δt² / (ρ·Δx²) = (c·Δt/Δx)², beyond max_stiffness_ratio at Δt = Min time step.
+//   (λ + 2μ)·Δt² / (ρ·Δx²) = (c·Δt/Δx)², beyond max_stiffness_ratio at Δt = Min time step;
+// - viscosity: the Newtonian term's Hessian, 2·c_N·V/Δx² per node (c_N the coefficient of
+//   Φ^N = c_N ε̂:ε̂ V, ε̂ = sym(A)/Δt), against the mass ρ·V: the viscous diffusion number
+//   η·Δt/(ρ·Δx²) = ν·Δt/Δx² (η = c_N/Δt whichever the convention), beyond max_stiffness_ratio at
+//   Δt = Min time step — the smallest it can be (c_N = Δt·η grows with Δt; the paper's μ^N does
+//   not depend on it).
 void check_physical_bounds(const SceneConfig& scene) {
   const double dx = scene.grid.cell_size, dt = scene.simulation.min_time_step;
   const double g = scene.simulation.gravity.stableNorm();  // no overflow: 1e300 stays 1e300
@@ -624,6 +652,21 @@ void check_physical_bounds(const SceneConfig& scene) {
            << max_stiffness_ratio << "), at every Δt the scene allows";
     throw parameter_error(scene.file, "Materials/" + m.name + (lambda > 2.0 * mu ? "/Lame lambda" : "/Shear modulus"),
                           reason.str());
+  }
+  for (const auto& m : scene.materials) {
+    if (!m.entry || !m.values.has("Density") || !m.values.has("Newtonian viscosity")) continue;
+    ParameterTable<materials::NewtonianParameters> newtonian;
+    materials::add_newtonian_parameters(newtonian);
+    const materials::NewtonianParameters viscous = newtonian.parse(m.values);
+    const double c_n = materials::viscous_coefficient(viscous.viscosity_convention, viscous.newtonian_viscosity, dt);
+    const double number = c_n / (m.values.real("Density") * dx * dx);
+    if (number <= max_stiffness_ratio) continue;
+    std::ostringstream reason;
+    reason.precision(3);
+    reason << "the viscous diffusion number η·Δt/(ρ·Δx²) = " << number << " at Simulation/Min time step (" << dt
+           << " s): the material's viscosity exceeds its inertia in a step by more than double precision holds ("
+           << max_stiffness_ratio << "), at every Δt the scene allows";
+    throw parameter_error(scene.file, "Materials/" + m.name + "/Newtonian viscosity", reason.str());
   }
 }
 
@@ -682,9 +725,7 @@ void check_keyframes(const ColliderSettings& c, const std::string& file, const s
 }
 
 // The fastest motion a scene prescribes, and the parameter that sets it.
-struct FastestMotion {
-  double speed = 0.0;
-  std::string parameter;
+struct FastestMotion : PrescribedMotion {
   void consider(double s, const std::string& path) {
     if (s > speed) {
       speed = s;
@@ -723,9 +764,14 @@ FastestMotion fastest_motion(const SceneConfig& scene) {
   return fastest;
 }
 
+}  // namespace
+
+PrescribedMotion fastest_prescribed_motion(const SceneConfig& scene) { return fastest_motion(scene); }
+
+namespace {
 // Δt follows the fastest motion (CFL); below Min time step a run could not take a step.
 void check_speeds(const SceneConfig& scene) {
-  const FastestMotion fastest = fastest_motion(scene);
+  const PrescribedMotion fastest = fastest_prescribed_motion(scene);
   if (!(fastest.speed > 0.0)) return;
   const double dt = scene.simulation.cfl * scene.grid.cell_size / fastest.speed;
   if (std::isfinite(fastest.speed) && dt >= scene.simulation.min_time_step) return;
@@ -784,7 +830,9 @@ void check_shapes_and_speeds(const SceneConfig& scene) {
 }
 }  // namespace
 
-SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides) {
+namespace {
+SceneConfig read_scene_in_stages(const std::string& file, const std::vector<Override>& overrides,
+                                 const StopAgreement& agree) {
   auto root = read_xml_file(file);
   for (const auto& o : overrides) apply_override(*root, o, file);
 
@@ -800,8 +848,23 @@ SceneConfig read_scene(const std::string& file, const std::vector<Override>& ove
   check_grid_and_time_steps(scene);
   check_physical_bounds(scene);
   check_settings(scene);
-  derive_from_cell_size(scene);  // meshes: the only part of reading that may take long
+  derive_from_cell_size(scene, agree);  // meshes: the only part of reading that may take long
   check_shapes_and_speeds(scene);
+  return scene;
+}
+}  // namespace
+
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides) {
+  return read_scene_in_stages(file, overrides, [](int signal) { return signal; });
+}
+
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides,
+                       const parallel::Communicator& comm) {
+  const StopAgreement agree = [&comm](int signal) { return static_cast<int>(comm.max(std::int64_t{signal})); };
+  SceneConfig scene = read_scene_in_stages(file, overrides, agree);
+  // The last stage: a request that came while the scene was read is agreed before the run's
+  // first collective.
+  if (const int agreed = agree(stop_signal())) throw StopRequested(agreed);
   return scene;
 }
 

@@ -44,7 +44,9 @@ Simulation::Simulation(const scene::SceneConfig& scene, materials::MaterialList 
       materials_(one_per_scene_material(std::move(materials), scene_)),
       boundary_(make_boundary(scene_)),
       state_(initial_state(scene_, geometry_, scene_.simulation.kernel, materials_, boundary_, comm_, restart_file)),
-      stepper_(scene_, state_, geometry_, scene_.simulation.kernel, materials_, boundary_, solver, comm_) {}
+      stepper_(scene_, state_, geometry_, scene_.simulation.kernel, materials_, boundary_, solver, comm_) {
+  frame_pieces_.stop = [] { return stop_signal(); };
+}
 
 RunControl RunControl::agreed(const RunControl& local, const parallel::Communicator& comm) {
   const std::vector<std::int64_t> all = comm.max(std::vector<std::int64_t>{
@@ -71,6 +73,17 @@ bool Simulation::stop_requested(RunSummary& summary, std::ostream* log) {
   if (control.solver_log_failed)
     throw SimulationError("cannot write " + solver_log_->path() + ": " + io::write_failure_reason(solver_log_->path()));
   if (!control.stop() && !control.checkpoint_due) return false;
+  write_wall_checkpoint();
+  if (!control.stop()) {
+    if (log && comm_.is_root()) *log << "  step " << state_.step << ": checkpoint " << *wall_checkpoint_ << "\n";
+    return false;
+  }
+  summary.stop_signal = control.stop_signal;
+  summary.stop_checkpoint = *wall_checkpoint_;
+  return true;
+}
+
+void Simulation::write_wall_checkpoint() {
   // A checkpoint between frames, replacing the one this run wrote before.
   const std::optional<std::string> previous = wall_checkpoint_;
   wall_checkpoint_ = write_checkpoint_file(io::step_checkpoint_file_name(state_.step));
@@ -79,13 +92,6 @@ bool Simulation::stop_requested(RunSummary& summary, std::ostream* log) {
     std::error_code ignored;
     std::filesystem::remove(*previous, ignored);
   }
-  if (!control.stop()) {
-    if (log && comm_.is_root()) *log << "  step " << state_.step << ": checkpoint " << *wall_checkpoint_ << "\n";
-    return false;
-  }
-  summary.stop_signal = control.stop_signal;
-  summary.stop_checkpoint = *wall_checkpoint_;
-  return true;
 }
 
 std::string Simulation::write_checkpoint() { return write_checkpoint_file(io::checkpoint_file_name(state_.frame)); }
@@ -98,9 +104,15 @@ std::string Simulation::write_checkpoint_file(const std::string& name) {
 }
 
 void Simulation::write_frame(int frame) {
+  const int previous = state_.frame;
   state_.frame = frame;
-  frames_.push_back(io::write_frame(scene_.output.directory, {frame, state_.time, state_.step, 0}, state_.particles,
-                                    materials_, comm_, frame_extras()));
+  try {
+    frames_.push_back(io::write_frame(scene_.output.directory, {frame, state_.time, state_.step, 0}, state_.particles,
+                                      materials_, comm_, frame_extras(), frame_pieces_));
+  } catch (const StopRequested&) {
+    state_.frame = previous;  // not written (its partial file removed): a restart writes it
+    throw;
+  }
   // Rank 0 writes the index; every rank learns whether it could.
   std::string failure;
   if (comm_.is_root()) {
@@ -180,6 +192,8 @@ RunSummary Simulation::run(std::ostream& log) {
   } leave{integrator()};
   stepper_.set_solver_log(solver_log_.get());
   const AfterStep after_step = [&] { return stop_requested(summary, &log); };
+  // A stop request while frame 0 is written (between its pieces) ends the run as one during its
+  // set-up does: StopRequested, nothing simulated, nothing to continue from.
   if (!state_.restarted) write_frame(0);
   log_start(log);
   const int frames = scene_.simulation.frames;
@@ -187,7 +201,16 @@ RunSummary Simulation::run(std::ostream& log) {
   const int first = state_.frame + 1;
   for (int frame = first; frame <= frames; ++frame) {
     if (!stepper_.advance_to(frame * frame_duration, summary, &log, after_step)) break;
-    write_frame(frame);
+    try {
+      write_frame(frame);
+    } catch (const StopRequested& e) {
+      // Agreed by every rank between two pieces of the frame's file, which is removed: the run
+      // stops as after a step, with a checkpoint from which a restart writes this frame.
+      write_wall_checkpoint();
+      summary.stop_signal = e.signal;
+      summary.stop_checkpoint = *wall_checkpoint_;
+      break;
+    }
     if (after_step()) break;  // a stop request that came while the frame was written
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const int done = frame - first + 1;

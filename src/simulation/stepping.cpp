@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <ostream>
+#include <sstream>
 
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/rcb_partition.hpp"
@@ -40,7 +41,29 @@ Stepper::Stepper(const scene::SceneConfig& scene, SimulationState& state, const 
       boundary_(boundary),
       comm_(comm),
       integrator_(std::make_unique<TimeIntegrator>(comm, geometry, order, *state.decomposition,
-                                                   integrator_settings(scene), materials, boundary, solver)) {}
+                                                   integrator_settings(scene), materials, boundary, solver)) {
+  for (const auto& m : materials) fastest_wave_speed_ = std::max(fastest_wave_speed_, m->wave_speed());
+}
+
+std::string Stepper::likely_cause() const {
+  // A motion the scene prescribes faster than every elastic wave of its materials: what it
+  // drives cannot carry the motion away (it piles up, folds, inverts — an infeasible state), at
+  // any Δt. No time-step criterion tells this at read time (each step resolves the motion), so
+  // the failure names it.
+  scene::PrescribedMotion fastest;
+  try {
+    fastest = scene::fastest_prescribed_motion(scene_);
+  } catch (const std::exception&) {
+    return "";  // a scene built in code with shapes the reader would not take: no hint
+  }
+  if (!(fastest_wave_speed_ > 0.0) || !(fastest.speed > fastest_wave_speed_)) return "";
+  std::ostringstream cause;
+  cause.precision(3);
+  cause << "; likely cause: parameter '" << fastest.parameter << "' prescribes up to " << fastest.speed << " m/s, "
+        << fastest.speed / fastest_wave_speed_ << " times the fastest elastic wave of the materials ("
+        << fastest_wave_speed_ << " m/s), faster than they can follow";
+  return cause.str();
+}
 
 void Stepper::emit_particles() {
   std::size_t added = 0;
@@ -153,7 +176,7 @@ StepOutcome Stepper::take_step(double dt, RunSummary& summary, std::ostream* log
     const double reduction = scene_.simulation.time_step_reduction;
     if (dt * reduction < scene_.simulation.min_time_step)
       throw SimulationError("at t = " + std::to_string(state_.time) + " with the smallest Δt: " + report.failure +
-                            "; the last frame written is frame " + std::to_string(state_.frame));
+                            "; the last frame written is frame " + std::to_string(state_.frame) + likely_cause());
     if (log && comm_.is_root() && ++retries_reported_ <= retries_logged)
       *log << "  step " << state_.step + 1 << ": " << report.failure << " at Δt = " << dt << ", retrying with Δt × "
            << reduction << (report.newton.converged ? std::string() : " [" + report.newton.history() + "]")

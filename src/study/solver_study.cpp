@@ -140,18 +140,19 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 // A scene of a systems study at cell size h: its overrides, then the cell size, so that what
-// derives from it (meshes' voxels, disc nozzles, the size checks) follows.
-scene::SceneConfig scene_at(const StudySettings::SceneEntry& entry, double h) {
+// derives from it (meshes' voxels, disc nozzles, the size checks) follows. Read by every rank of
+// `comm` together when given (stop requests agreed between meshes), else by this rank alone.
+scene::SceneConfig scene_at(const StudySettings::SceneEntry& entry, double h, const parallel::Communicator* comm = nullptr) {
   std::vector<scene::Override> overrides;
   for (const auto& o : entry.overrides) overrides.push_back(scene::Override::parse(o));
   overrides.push_back({"Grid/Cell size", exact(h)});
-  return scene::read_scene(entry.scene, overrides);
+  return comm ? scene::read_scene(entry.scene, overrides, *comm) : scene::read_scene(entry.scene, overrides);
 }
 
 // The scene of a steps configuration: the study's scene overrides, the cell size h (0: as they
 // leave it), then the configuration's Newton overrides.
 scene::SceneConfig scene_for(const StudySettings& settings, const StudySettings::Configuration& configuration,
-                             double h) {
+                             double h, const parallel::Communicator* comm = nullptr) {
   std::vector<scene::Override> overrides;
   for (const auto& o : settings.scene_overrides) overrides.push_back(scene::Override::parse(o));
   if (h > 0.0) overrides.push_back({"Grid/Cell size", exact(h)});
@@ -160,7 +161,7 @@ scene::SceneConfig scene_for(const StudySettings& settings, const StudySettings:
     newton.path = "Newton/" + newton.path;
     overrides.push_back(newton);
   }
-  return scene::read_scene(settings.scene, overrides);
+  return comm ? scene::read_scene(settings.scene, overrides, *comm) : scene::read_scene(settings.scene, overrides);
 }
 
 // The output directory, created on rank 0; every rank learns whether it could be.
@@ -253,7 +254,7 @@ SystemsInputs read_systems_inputs(const StudySettings& settings, const parallel:
   for (const auto& s : settings.solvers) inputs.configs.push_back(linalg::SolverConfiguration::read(s));
   for (const auto& entry : settings.scenes)
     for (double h : entry.cell_sizes) {
-      inputs.scenes.emplace_back(&entry, scene_at(entry, h));
+      inputs.scenes.emplace_back(&entry, scene_at(entry, h, &comm));
       simulation::check_memory(inputs.scenes.back().second, comm);
     }
   for (const auto& file : settings.matrix_market_files)
@@ -422,7 +423,7 @@ int study_steps(const StudySettings& settings, const std::string& study_file, co
   const std::vector<double> cell_sizes = settings.cell_sizes.empty() ? std::vector<double>{0.0} : settings.cell_sizes;
   for (double h : cell_sizes)
     for (const auto& configuration : settings.configurations) {
-      scenes.push_back(scene_for(settings, configuration, h));
+      scenes.push_back(scene_for(settings, configuration, h, &comm));
       configurations.push_back(&configuration);
       simulation::check_memory(scenes.back(), comm);
     }

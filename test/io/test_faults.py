@@ -2,9 +2,11 @@
 """What a batch system does to a run, end to end (doc/contracts.md, "Stopping, failing, restarting"):
 - SIGTERM to one rank only, SIGINT to another, SIGUSR1 to mpiexec: exit 4 after a checkpoint,
   one message; --restart continues to the frames of an uninterrupted run, bit for bit.
+- SIGUSR1 to one rank only while a mesh's level set is built: every rank stops, exit 4.
 - The disk fills during the run (a small tmpfs, else a file-size limit): exit 3 with one line,
   every file written before intact, nothing half-written left.
 - The output directory disappears during the run: exit 3, the earlier frames intact.
+- A collider spun faster than the material's elastic waves: exit 3 naming its Angular velocity.
 - A truncated, foreign or corrupted checkpoint: exit 2 with one line naming it."""
 import glob
 import os
@@ -132,6 +134,51 @@ for name, how in [("sigterm_one_rank", "term"), ("sigint_rank0", "int"), ("sigus
         grids = ET.parse(os.path.join(out, "particles.xdmf")).getroot().findall("./Domain/Grid[@Name='particles']/Grid")
         check(len(grids) == frames + 1, f"{name}: the XDMF index lists every frame once: {len(grids)}")
 
+# Issue 24: SIGUSR1 to the last rank only while the ranks build a mesh's level set (the toothbrush
+# at fine voxels: seconds), as soon as its handler is installed. Every rank agrees on the request
+# after that stage: exit 4 with one line saying nothing was simulated, no frame written, within a
+# minute. (The signalled rank used to leave alone and the others to wait at the run's first
+# collective until killed.)
+def catches(pid, signum):
+    """Whether process `pid` has installed a handler for `signum` (/proc/PID/status, SigCgt)."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("SigCgt:"):
+                    return bool(int(line.split()[1], 16) >> (signum - 1) & 1)
+    except OSError:
+        pass
+    return False
+
+
+out = os.path.join(args.workdir, "stop_during_level_set")
+toothpaste = os.path.join(args.inputs, "scenes", "paper", "toothpaste.xml")
+process = subprocess.Popen(shlex.split(args.mpiexec) + ["-np", str(args.ranks), args.viscompm, toothpaste, "--frames", "1",
+                                                        "--output", out, "--set", "Colliders/toothbrush/Voxel size=0.0007"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+deadline = time.time() + 30
+ranks = []
+while time.time() < deadline and process.poll() is None:
+    ranks = ranks_of(process)
+    if len(ranks) == args.ranks and all(catches(pid, signal.SIGUSR1) for pid in ranks):
+        break
+    time.sleep(0.01)
+check(len(ranks) == args.ranks, f"stop during a level set: found the {args.ranks} ranks: {ranks}")
+if ranks:
+    os.kill(ranks[-1], signal.SIGUSR1)
+try:
+    stdout, stderr = process.communicate(timeout=60)
+except subprocess.TimeoutExpired:
+    for pid in ranks_of(process):
+        os.kill(pid, signal.SIGKILL)
+    os.killpg(process.pid, signal.SIGKILL)
+    stdout, stderr = process.communicate()
+    check(False, "stop during a level set: the ranks not signalled were left waiting (killed after 60 s)")
+check(process.returncode == 4, f"stop during a level set: exit 4, got {process.returncode}: {stderr[-500:]}")
+lines = our_lines(stderr)
+check(len(lines) == 1 and "nothing was simulated" in lines[0], f"stop during a level set: one line: {lines}")
+check(not glob.glob(os.path.join(out, "frame_*")), "stop during a level set: no frame written")
+
 # The disk fills: a tmpfs that holds frame 0, its checkpoint and frame 1, not more.
 frame_bytes = os.path.getsize(os.path.join(reference_dir, "frame_00000.h5"))
 full = os.path.join(args.workdir, "full")
@@ -180,6 +227,19 @@ check(process.returncode == 3, f"vanishing directory: exit 3, got {process.retur
 check(len(our_lines(stderr)) == 1, f"vanishing directory: one line: {our_lines(stderr)}")
 kept = sorted(glob.glob(os.path.join(out + ".moved", "frame_*.h5")))
 check(len(kept) >= 3 and all(readable(p) for p in kept), f"vanishing directory: earlier frames intact: {kept}")
+
+# A sticky grip spun far faster than any elastic wave of the sponge it twists (issue 24): no
+# read-time bound holds (every step resolves the motion: the CFL step follows the rim's speed), so
+# the run fails at the smallest Δt — exit 3, one line naming the parameter behind it.
+spun = subprocess.run(shlex.split(args.mpiexec) + ["-np", str(args.ranks), args.viscompm,
+                                                   os.path.join(args.inputs, "scenes", "paper", "twisting_sponge.xml"),
+                                                   "--frames", "1", "--output", os.path.join(args.workdir, "spun"),
+                                                   "--set", "Colliders/top grip/Angular velocity={0, 1e4, 0}"],
+                      capture_output=True, text=True, timeout=300)
+lines = our_lines(spun.stderr)
+check(spun.returncode == 3, f"spun grip: exit 3, got {spun.returncode}: {spun.stderr[-400:]}")
+check(len(lines) == 1 and "'Colliders/top grip/Angular velocity'" in lines[0],
+      f"spun grip: one line naming the angular velocity: {lines}")
 
 # Checkpoints that cannot be restarted from: exit 2, one line naming the file.
 bad = os.path.join(args.workdir, "bad_checkpoints")

@@ -266,7 +266,8 @@ TEST(Scene, PhysicalBoundsNameTheParameter) {
            {"Simulation/Gravity", "{0, -1e300, 0}", "no step can be taken"},
            {"Materials/sponge/Lame lambda", "1e300", "more than double precision holds"},
            {"Materials/sponge/Shear modulus", "1e300", "more than double precision holds"},
-           {"Materials/sponge/Density", "1e-300", "out of range"}}) {
+           {"Materials/sponge/Density", "1e-300", "out of range"},
+           {"Materials/sponge/Newtonian viscosity", "1e300", "more than double precision holds"}}) {
     const std::string message = read_error(default_scene, {{path, value}});
     expect_one_line_naming(message, default_scene, path);
     EXPECT_NE(message.find(reason), std::string::npos) << message;
@@ -276,7 +277,22 @@ TEST(Scene, PhysicalBoundsNameTheParameter) {
   EXPECT_NE(read_error(default_scene, {{"Simulation/Gravity", "{0, -1.9e12, 0}"}}), "");
   EXPECT_EQ(read_error(default_scene, {{"Materials/sponge/Lame lambda", "4e26"}}), "");
   EXPECT_NE(read_error(default_scene, {{"Materials/sponge/Lame lambda", "5e26"}}), "");
-  // Physical extremes still read: steel's stiffness, 100 g, a light foam.
+  // The viscous diffusion number η·Δt_min/(ρ·Δx²) at 1/ε = 4.5e15: the default scene's paper
+  // convention (η = μ^N/Δt) bounds μ^N at 4.05e12 Pa whatever Δt, the physical one η at 4.05e19 Pa·s.
+  EXPECT_EQ(read_error(default_scene, {{"Materials/sponge/Newtonian viscosity", "4e12"}}), "");
+  EXPECT_NE(read_error(default_scene, {{"Materials/sponge/Newtonian viscosity", "5e12"}}), "");
+  const std::string physical = "Materials/sponge/Viscosity convention";
+  EXPECT_EQ(read_error(default_scene, {{physical, "physical"}, {"Materials/sponge/Newtonian viscosity", "4e19"}}), "");
+  const std::string too_viscous =
+      read_error(default_scene, {{physical, "physical"}, {"Materials/sponge/Newtonian viscosity", "5e19"}});
+  expect_one_line_naming(too_viscous, default_scene, "Materials/sponge/Newtonian viscosity");
+  // A bound that follows Simulation/Min time step: ten times larger steps, a tenth of the viscosity.
+  EXPECT_NE(read_error(default_scene, {{physical, "physical"}, {"Materials/sponge/Newtonian viscosity", "5e18"},
+                                       {"Simulation/Min time step", "1e-6"}}),
+            "");
+  // Physical extremes still read: steel's stiffness, 100 g, a light foam, glass near its
+  // transition (1e12 Pa·s, physical convention).
+  EXPECT_EQ(read_error(default_scene, {{physical, "physical"}, {"Materials/sponge/Newtonian viscosity", "1e12"}}), "");
   EXPECT_EQ(read_error(default_scene, {{"Materials/sponge/Lame lambda", "1e11"}, {"Simulation/Gravity", "{0, -981, 0}"},
                                        {"Materials/sponge/Density", "0.01"}}),
             "");

@@ -98,6 +98,9 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   clear_stop_signal();
   if (world.rank() == world.size() - 1) std::raise(SIGTERM);
   simulation::Simulation stopped(every_step(short_run(dir + "/stopped")), solver, world);
+  // Frame 0 written whole, as if the signal came right after it (a request pending while a frame
+  // is written ends the write: DuringAFramesFile... below).
+  stopped.frame_pieces().stop = {};
   const auto summary = stopped.run(log);
   clear_stop_signal();
   EXPECT_EQ(summary.stop_signal, SIGTERM);
@@ -235,4 +238,123 @@ TEST(NonFiniteSteps, EndTheRunWithTheFramesWrittenSoFarIntact) {
   bool finite = true;
   for (std::size_t p = 0; p < frame0.size(); ++p) finite &= frame0.deformation_gradient[p].allFinite();
   EXPECT_FALSE(world.any(!finite));
+}
+
+// Issue 24: a stop request that reaches one rank while the scene's meshes are read (a mesh's level
+// set, the long part of setting a run up) ends reading on every rank at the same stage, with
+// StopRequested: no rank goes on to the run's first collective to wait there for one that left
+// (it used to: the signalled rank ended, the others hung until killed).
+TEST(StopRequest, DuringAMeshsLevelSetReachesEveryRankBeforeTheNextCollective) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string toothpaste = VISCOMPM_SOURCE_DIR "/inputs/scenes/paper/toothpaste.xml";
+  const std::vector<scene::Override> coarse = {{"Colliders/toothbrush/Voxel size", "0.02"}};
+  install_stop_handlers();
+  clear_stop_signal();
+  if (world.rank() == world.size() - 1) std::raise(SIGUSR1);
+  int stopped = 0;
+  try {
+    (void)scene::read_scene(toothpaste, coarse, world);
+  } catch (const StopRequested& e) {
+    stopped = e.signal;
+  }
+  clear_stop_signal();
+  EXPECT_EQ(stopped, SIGUSR1) << "rank " << world.rank() << " did not stop with the others";
+  // Every rank is here, at the same collective; without a request the same reading completes.
+  EXPECT_EQ(world.sum(std::int64_t{stopped != 0}), world.size());
+  scene::SceneConfig scene;
+  EXPECT_NO_THROW(scene = scene::read_scene(toothpaste, coarse, world));
+  ASSERT_EQ(scene.colliders.size(), 1u);
+  EXPECT_TRUE(scene.colliders[0].field != nullptr);
+}
+
+namespace {
+// Whether `path` exists, as rank 0 sees it, on every rank.
+bool exists_on_root(const parallel::Communicator& world, const std::string& path) {
+  return world.any(world.is_root() && std::filesystem::exists(path));
+}
+}  // namespace
+
+// Issue 24: a frame's particle file is written in pieces, between which the ranks agree on a stop
+// request. A request that reaches the last rank in the middle of frame 1's file ends the write on
+// every rank at the same piece, the partial file is removed, and the run stops as after a step:
+// a checkpoint from which --restart writes frame 1 and goes on, bit for bit as a run never
+// stopped. (Before, a frame was written whole whatever came: a 7-GB frame outlived the grace of
+// a batch system's SIGTERM.)
+TEST(StopRequest, DuringAFramesFileRemovesThePartialFileAndStopsEveryRank) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = testkit::work_directory(world, "stop_during_frame");
+  const auto solver = testkit::jacobi_cg(1e-12);
+  std::ostringstream log;
+  auto every_step = [](scene::SceneConfig scene) {
+    scene.output.checkpoint_wall_seconds = 1e-9;
+    return scene;
+  };
+  simulation::Simulation straight(every_step(short_run(dir + "/straight")), solver, world);
+  ASSERT_EQ(straight.run(log).stop_signal, 0);
+  const auto reference = testkit::gather_particles(straight.particles(), world.comm());
+
+  install_stop_handlers();
+  clear_stop_signal();
+  simulation::Simulation stopped(every_step(short_run(dir + "/stopped")), solver, world);
+  io::WritePieces& pieces = stopped.frame_pieces();
+  pieces.rows = 16;
+  const std::function<int()> signal_of_this_rank = pieces.stop;
+  int asked = 0;  // in frame 1's file
+  pieces.stop = [&] {
+    if (stopped.time() > 0.0 && ++asked == 5 && world.rank() == world.size() - 1) std::raise(SIGTERM);
+    return signal_of_this_rank();
+  };
+  ASSERT_GT(world.max(static_cast<std::int64_t>(stopped.particles().size())), 5 * 16) << "too few pieces";
+  const auto summary = stopped.run(log);
+  clear_stop_signal();
+  EXPECT_EQ(summary.stop_signal, SIGTERM);
+  EXPECT_EQ(asked, 5) << "every rank ends the write at the piece after which the request came";
+  EXPECT_EQ(stopped.time(), 1.0 / 120.0) << "stopped at frame 1's time, its steps taken";
+  EXPECT_FALSE(exists_on_root(world, dir + "/stopped/" + io::frame_file_name(1)));
+  EXPECT_FALSE(exists_on_root(world, dir + "/stopped/" + io::frame_file_name(1) + ".tmp")) << "the partial file";
+  EXPECT_TRUE(exists_on_root(world, dir + "/stopped/" + io::frame_file_name(0)));
+  EXPECT_EQ(summary.stop_checkpoint, dir + "/stopped/" + io::step_checkpoint_file_name(stopped.step_count()));
+  EXPECT_TRUE(exists_on_root(world, summary.stop_checkpoint));
+
+  simulation::Simulation continued(every_step(short_run(dir + "/stopped")), solver, world, summary.stop_checkpoint);
+  const auto rest = continued.run(log);
+  EXPECT_EQ(rest.stop_signal, 0);
+  EXPECT_EQ(continued.step_count(), straight.step_count());
+  const auto result = testkit::gather_particles(continued.particles(), world.comm());
+  EXPECT_TRUE(testkit::bitwise_equal(reference, result)) << "difference " << testkit::max_state_difference(reference, result);
+  for (int frame = 0; frame <= 3; ++frame)
+    EXPECT_TRUE(exists_on_root(world, dir + "/stopped/" + io::frame_file_name(frame))) << "frame " << frame;
+}
+
+// A request agreed while frame 0 is written ends the run as one during its set-up: StopRequested
+// on every rank, no frame, no checkpoint (nothing was simulated).
+TEST(StopRequest, DuringFrameZerosFileEndsTheRunAsDuringItsSetUp) {
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const std::string dir = testkit::work_directory(world, "stop_during_frame_zero");
+  install_stop_handlers();
+  clear_stop_signal();
+  simulation::Simulation sim(short_run(dir), testkit::jacobi_cg(1e-10), world);
+  io::WritePieces& pieces = sim.frame_pieces();
+  pieces.rows = 16;
+  const std::function<int()> signal_of_this_rank = pieces.stop;
+  int asked = 0;
+  pieces.stop = [&] {
+    if (++asked == 3 && world.is_root()) std::raise(SIGINT);
+    return signal_of_this_rank();
+  };
+  std::ostringstream log;
+  int stopped = 0;
+  try {
+    sim.run(log);
+  } catch (const StopRequested& e) {
+    stopped = e.signal;
+  }
+  clear_stop_signal();
+  EXPECT_EQ(stopped, SIGINT);
+  EXPECT_EQ(asked, 3);
+  EXPECT_EQ(sim.step_count(), 0);
+  if (world.is_root()) {
+    EXPECT_TRUE(files_starting_with(dir, "frame_").empty());
+    EXPECT_TRUE(files_starting_with(dir, "checkpoint").empty());
+  }
 }

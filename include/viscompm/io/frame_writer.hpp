@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "viscompm/io/particle_file.hpp"
 #include "viscompm/materials/material.hpp"
 #include "viscompm/parallel/communicator.hpp"
 #include "viscompm/particles/particle_set.hpp"
@@ -37,10 +38,12 @@ std::string frame_file_name(int frame);
 /// Writes DIR/frame_NNNNN.h5 collectively: every field of ParticleSet::for_each_field under
 /// /particles (plus left_cauchy_green_elastic from each material). Rows are in rank order;
 /// `id` identifies particles.
-/// Returns the frame's info with the global particle count.
+/// Returns the frame's info with the global particle count. Written in `pieces`, between which
+/// a stop request removes the partial file and throws StopRequested on every rank
+/// (write_particle_file).
 FrameInfo write_frame(const std::string& directory, FrameInfo info, const particles::ParticleSet& particles,
                       const materials::MaterialList& materials, const parallel::Communicator& comm,
-                      const FrameExtras& extras = {});
+                      const FrameExtras& extras = {}, const WritePieces& pieces = {});
 
 /// The material names in material_id order, comma-separated (an attribute of /particles).
 std::string material_names(const materials::MaterialList& materials);

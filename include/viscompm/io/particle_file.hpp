@@ -36,13 +36,27 @@ struct Table {
   std::vector<std::int64_t> integers;
 };
 
+/// How a particle file is written in pieces, and whether it may be given up between them: each
+/// dataset of /particles goes in collective writes of at most `rows` rows per rank, and after each
+/// the ranks agree (one collective) on whether a write failed and on `stop`.
+struct WritePieces {
+  /// Rows per rank in one write (at least 1): 2^20 rows of a 3×3 tensor are 72 MiB, well under a
+  /// second on a local disk, so that a stop request is honoured within about that.
+  std::int64_t rows = std::int64_t{1} << 20;
+  /// This rank's stop request now (a signal number, 0: none), asked after every piece; empty:
+  /// the file is written whole (checkpoints, which a stop itself writes).
+  std::function<int()> stop;
+};
+
 /// Writes `particles` (this rank's rows, in rank order) to `path` (collective), through PATH.tmp
 /// renamed when complete, with `tables` (rank 0's rows); returns the global count. If any rank fails to write, every rank throws
-/// SimulationError and `path` is left as it was.
+/// SimulationError and `path` is left as it was. If any rank's `pieces.stop` asks to stop between
+/// two pieces, the partial PATH.tmp is removed and every rank throws StopRequested with the
+/// largest signal asked for (`path` left as it was).
 std::int64_t write_particle_file(const std::string& path, const FileAttributes& attributes,
                                  const particles::ParticleSet& particles, const std::vector<DerivedTensor>& derived,
                                  const std::string& material_names, const parallel::Communicator& comm,
-                                 const std::vector<Table>& tables = {});
+                                 const std::vector<Table>& tables = {}, const WritePieces& pieces = {});
 
 /// Why writing `path` may have failed: its directory missing or read-only, the disk full, ...
 std::string write_failure_reason(const std::string& path);

@@ -28,6 +28,7 @@
 #include "viscompm/linalg/linear_solver.hpp"
 #include "viscompm/materials/registry.hpp"
 #include "viscompm/newton/newton_settings.hpp"
+#include "viscompm/parallel/communicator.hpp"
 #include "viscompm/transfer/transfer.hpp"
 
 namespace viscompm::scene {
@@ -170,6 +171,15 @@ Shape shape_of(const ShapeSettings& settings);
 /// The collider a scene describes: its shape, contact, rigid motion and surface velocity.
 boundary::Collider collider_of(const ColliderSettings& settings);
 
+/// The fastest motion a scene prescribes — a body's initial velocity and rotation, a collider's
+/// translation, rotation at its farthest point, keyframes and surface velocity, an emitter's
+/// velocity — and the parameter that sets it ("Colliders/<name>/Angular velocity"); speed 0 if none.
+struct PrescribedMotion {
+  double speed = 0.0;  ///< [m/s]
+  std::string parameter;
+};
+PrescribedMotion fastest_prescribed_motion(const SceneConfig& scene);
+
 /// A --set override: "Path/To/Parameter=value".
 struct Override {
   std::string path;
@@ -181,6 +191,13 @@ struct Override {
 /// from others (mesh voxels and disc nozzles from Grid/Cell size) is computed after them. Throws
 /// InputError.
 SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides = {});
+/// The same, read by every rank of `comm` together (the programs), in stages: each mesh's level
+/// set — the part of reading that may take long, which a stop request (core/stop_request.hpp)
+/// ends on the rank that receives it — is followed by the ranks' agreement on a stop request,
+/// and so is the end of reading. A request that reaches only some ranks thus ends reading with
+/// StopRequested on every rank at the same stage: none is left waiting at a collective.
+SceneConfig read_scene(const std::string& file, const std::vector<Override>& overrides,
+                       const parallel::Communicator& comm);
 
 /// Resolves the names a scene refers to — material names of bodies, emitters and regions, the
 /// bodies of regions, the models of materials — to indices and registry entries (read_scene does

@@ -83,6 +83,12 @@ class Simulation {
   io::FrameExtras frame_extras() const;
   /// Writes DIR/surface_NNNNN.{obj,vdb}: the particles' surface (Output/Surface voxel size).
   void write_surface(int frame) const;
+  /// How run() writes a frame's particle file: in pieces (io::WritePieces), between which the
+  /// ranks agree on a stop request (this rank's signal, stop_request.hpp). A request agreed there
+  /// removes the partial frame file and stops the run as after a step (checkpoint, RunSummary's
+  /// stop_signal; the frame is written by the restart) — or, for frame 0, throws StopRequested
+  /// (nothing simulated). Tests make the pieces small and wrap `stop`.
+  io::WritePieces& frame_pieces() { return frame_pieces_; }
 
  private:
   scene::SceneConfig scene_;
@@ -96,12 +102,16 @@ class Simulation {
   std::vector<io::FrameInfo> frames_;
   std::chrono::steady_clock::time_point last_checkpoint_time_;
   std::optional<std::string> wall_checkpoint_;  ///< the last checkpoint written between frames by this run
+  io::WritePieces frame_pieces_;                ///< how frames are written (stop: this rank's signal)
 
   /// This rank's view of the run's control state now (its own signal, clock and log).
   RunControl local_control() const;
   /// After a step inside run(): agrees on the RunControl, writes the checkpoint it asks for;
   /// true if the run must stop (its checkpoint written).
   bool stop_requested(RunSummary& summary, std::ostream* log);
+  /// Writes DIR/checkpoint_step_SSSSSSSS.h5 (the steps taken) and removes the one this run wrote
+  /// between frames before; wall_checkpoint_ names it.
+  void write_wall_checkpoint();
   /// Writes DIR/NAME and resets the integrator's reuse, as write_checkpoint.
   std::string write_checkpoint_file(const std::string& name);
   void write_frame(int frame);

@@ -83,6 +83,11 @@ class Stepper {
   std::unique_ptr<TimeIntegrator> integrator_;
   io::SolverLog* solver_log_ = nullptr;
   int retries_reported_ = 0;
+  double fastest_wave_speed_ = 0.0;  ///< the largest Material::wave_speed of the scene's materials
+
+  /// What a step failing at the smallest Δt may owe to a parameter: a prescribed motion faster
+  /// than every material's elastic waves ("; likely cause: parameter '...' ..."), or "".
+  std::string likely_cause() const;
 
   /// Re-partitions the grid when the particle counts of the ranks drift apart (Grid/Rebalance
   /// threshold) and migrates the particles (collective).
