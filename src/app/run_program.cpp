@@ -87,7 +87,7 @@ int run_simulation_program(int argc, char** argv) {
     if (const auto* choice = simulation.integrator().solver_choice(); choice != nullptr && root) {
       std::cout << solver.label() << ":";
       for (std::size_t k = 0; k < solver.candidates().size(); ++k)
-        std::cout << (k == 0 ? " " : ", ") << solver.candidates()[k].label() << " " << choice->systems()[k] << " steps";
+        std::cout << (k == 0 ? " " : ", ") << solver.candidates()[k].label() << " " << choice->systems()[k] << " systems";
       std::cout << "; " << choice->trials() << " trials, " << choice->switches() << " switches\n";
     }
     return exit_success;

@@ -190,14 +190,14 @@ namespace {
 struct ChoiceFile {
   std::string label;
   StringList candidates;
-  int trial_systems = 1;
-  int recheck_systems = 16;
-  int max_recheck_systems = 256;
+  int recheck_steps = 16;
+  int max_recheck_steps = 256;
   double regime_change = 2.0;
-  int regime_systems = 4;
+  int regime_steps = 4;
+  double trial_overhead = 0.05;
 
   SolverChoiceSettings schedule() const {
-    return {trial_systems, recheck_systems, max_recheck_systems, regime_change, regime_systems};
+    return {recheck_steps, max_recheck_steps, regime_change, regime_steps, trial_overhead};
   }
   static const ParameterTable<ChoiceFile>& table() {
     static const ParameterTable<ChoiceFile> t = [] {
@@ -205,16 +205,19 @@ struct ChoiceFile {
       using C = ChoiceFile;
       table.string(&C::label, "Label", "measured choice", {}, "name of this choice in messages")
           .string_list(&C::candidates, "Choose between", {},
-                       "solver files (relative to this one) of which the run uses the cheapest per Newton system, as measured")
-          .integer(&C::trial_systems, "Trial systems", 1, Range::closed(1, 100), "Newton systems each candidate solves in a trial")
-          .integer(&C::recheck_systems, "Recheck systems", 16, Range::closed(1, 1000000),
-                   "Newton systems of the chosen one before the others are tried again")
-          .integer(&C::max_recheck_systems, "Max recheck systems", 256, Range::closed(1, 1000000),
+                       "solver files (relative to this one) of which the run uses the cheapest per time step, as "
+                       "measured; each is tried for one step in this order (the one whose worst case is mildest first)")
+          .integer(&C::recheck_steps, "Recheck steps", 16, Range::closed(1, 1000000),
+                   "steps of the chosen one before the others are tried again")
+          .integer(&C::max_recheck_steps, "Max recheck steps", 256, Range::closed(1, 1000000),
                    "the interval between trials doubles, each time a trial confirms the choice, up to this")
           .real(&C::regime_change, "Regime change", 2.0, Range::open_closed(1.0, 1e6),
-                "a trial at once when the chosen one's recent seconds per Newton system move by this factor from its trial's")
-          .integer(&C::regime_systems, "Regime systems", 4, Range::closed(1, 1000000),
-                   "Newton systems after a trial before a regime change is looked for");
+                "a trial at once when the chosen one's recent seconds per step move by this factor from its trial's")
+          .integer(&C::regime_steps, "Regime steps", 4, Range::closed(1, 1000000),
+                   "steps after a trial before a regime change is looked for")
+          .real(&C::trial_overhead, "Trial overhead", 0.05, Range::open_closed(0.0, 1.0),
+                "the next trial waits until the losers' last trial steps, beyond the winner's cost, are at most "
+                "this share of the winner's steps in between (capped by Max recheck steps)");
       return table;
     }();
     return t;
@@ -236,9 +239,9 @@ std::shared_ptr<SolverConfiguration::Impl> parse_choice(const Teuchos::Parameter
   if (file.candidates.size() < 2)
     throw parameter_error(origin, "Choose between", "a measured choice needs at least two solver files, got " +
                                                         std::to_string(file.candidates.size()));
-  if (file.max_recheck_systems < file.recheck_systems)
-    throw parameter_error(origin, "Max recheck systems", "is less than Recheck systems (" +
-                                                           std::to_string(file.recheck_systems) + ")");
+  if (file.max_recheck_steps < file.recheck_steps)
+    throw parameter_error(origin, "Max recheck steps", "is less than Recheck steps (" +
+                                                           std::to_string(file.recheck_steps) + ")");
   for (const std::string& name : file.candidates) {
     const std::string path = !name.empty() && name[0] == '/' ? name : directory + name;
     if (!std::ifstream(path))

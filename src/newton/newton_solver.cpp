@@ -114,6 +114,7 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
   // the residual after the last direction is tested once more.
   const auto finish = [&]() -> NewtonReport {
     if (!report.converged) forget();
+    if (choice_ && !report.interrupted) choice_->step_ended();
     return report;
   };
   for (int direction = 0; direction < settings_.max_iterations; ++direction) {
@@ -123,16 +124,10 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
     select_candidate(step);
     // Direction, then the line search along it (both inside: a failed line search may call for a
     // fresh or projected Hessian).
-    const std::size_t solves = report.linear_solves.size();
     const bool moved = settings_.method == Method::lbfgs ? lbfgs_direction_and_line_search(step, g, dv)
                                                          : newton_direction_and_line_search(step, g, dv);
-    if (choice_) {
-      // The direction's cost, the same on every rank, per decade its solve reduced the residual
-      // (a later Newton iteration asks CG for more than the first).
-      const double tolerance = report.linear_solves.size() > solves ? report.linear_solves.back().tolerance : 0.0;
-      const double decades = tolerance > 0.0 && tolerance < 0.1 ? -std::log10(tolerance) : 1.0;
-      choice_->solved(comm_.max(seconds_since(start)) / decades);
-    }
+    // What the direction cost, the slowest rank's, so that every rank chooses the same.
+    if (choice_) choice_->direction_solved(comm_.max(seconds_since(start)));
     if (!moved) return finish();
   }
   if (!residual_settles(step, g) && report.failure.empty())

@@ -1,6 +1,7 @@
 #include "viscompm/newton/solver_choice.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace viscompm::newton {
@@ -13,68 +14,92 @@ constexpr double recent_weight = 0.25;
 SolverChoice::SolverChoice(int candidates, const linalg::SolverChoiceSettings& settings)
     : settings_(settings),
       candidates_(candidates),
-      trial_seconds_(static_cast<std::size_t>(candidates), 0.0),
-      trial_systems_(static_cast<std::size_t>(candidates), 0),
+      trial_cost_(static_cast<std::size_t>(candidates), -1.0),
       systems_(static_cast<std::size_t>(candidates), 0),
-      interval_(settings.recheck_systems) {
+      interval_(settings.recheck_steps) {
   if (candidates < 1) throw std::invalid_argument("SolverChoice: no candidate");
+  in_trial_ = candidates > 1;
 }
 
-void SolverChoice::solved(double seconds) {
+int SolverChoice::cheapest() const {
+  int best = -1;
+  for (int c = 0; c < candidates_; ++c)
+    if (trial_cost_[c] >= 0.0 && (best < 0 || trial_cost_[c] < trial_cost_[best])) best = c;
+  return best;
+}
+
+void SolverChoice::direction_solved(double seconds) {
   ++systems_[next_];
+  ++step_directions_;
+  step_cost_ += seconds;
+  // A candidate on trial that already cost more than the best step of this trial has lost: the
+  // best one finishes the step.
+  if (!in_trial_ || lost_ || next_ != on_trial_) return;
+  const int best = cheapest();
+  if (best >= 0 && step_cost_ > trial_cost_[best]) {
+    lost_ = true;
+    ++stopped_early_;
+    trial_cost_[on_trial_] = step_cost_;
+    next_ = best;
+  }
+}
+
+void SolverChoice::step_ended() {
+  // A step whose initial guess already converged measured nothing.
+  if (step_directions_ == 0) return;
+  const double cost = step_cost_;
+  step_cost_ = 0.0;
+  step_directions_ = 0;
   if (in_trial_) {
-    trial_seconds_[next_] += seconds;
-    ++trial_systems_[next_];
-    // The next candidate still to be tried, in order; the trial ends when none is left.
-    for (int c = 0; c < candidates_; ++c)
-      if (trial_systems_[c] < settings_.trial_systems) {
-        next_ = c;
-        return;
-      }
-    end_trial();
+    if (!lost_) trial_cost_[on_trial_] = cost;
+    lost_ = false;
+    next_trial_candidate();
     return;
   }
   // The chosen one: its recent cost, and a trial when it is due or the cost left its regime.
-  recent_ = since_trial_ == 0 ? seconds : (1.0 - recent_weight) * recent_ + recent_weight * seconds;
+  recent_ = since_trial_ == 0 ? cost : (1.0 - recent_weight) * recent_ + recent_weight * cost;
   ++since_trial_;
-  const bool regime_changed = since_trial_ >= settings_.regime_systems &&
-                              (recent_ > settings_.regime_change * reference_ ||
-                               recent_ * settings_.regime_change < reference_);
-  if (regime_changed) interval_ = settings_.recheck_systems;
+  // A change smaller than the margin the loser lost by cannot reverse the choice.
+  const double factor = std::max(settings_.regime_change, margin_);
+  const bool regime_changed = since_trial_ >= settings_.regime_steps &&
+                              (recent_ > factor * reference_ || recent_ * factor < reference_);
+  if (regime_changed) interval_ = settings_.recheck_steps;
   if (regime_changed || since_trial_ >= interval_) start_trial();
 }
 
 void SolverChoice::start_trial() {
-  if (candidates_ == 1) {
-    since_trial_ = 0;
-    reference_ = recent_;
-    return;
-  }
+  if (candidates_ == 1) return;
   in_trial_ = true;
-  std::fill(trial_seconds_.begin(), trial_seconds_.end(), 0.0);
-  std::fill(trial_systems_.begin(), trial_systems_.end(), 0);
-  // The chosen one is not run again: its recent cost stands for it.
-  trial_systems_[chosen_] = settings_.trial_systems;
-  trial_seconds_[chosen_] = recent_ * settings_.trial_systems;
-  for (int c = 0; c < candidates_; ++c)
-    if (trial_systems_[c] < settings_.trial_systems) {
-      next_ = c;
-      break;
-    }
+  std::fill(trial_cost_.begin(), trial_cost_.end(), -1.0);
+  trial_cost_[chosen_] = recent_;  // the chosen one is not run again: its recent cost stands for it
+  next_trial_candidate();
 }
 
-void SolverChoice::end_trial() {
-  int best = 0;
-  for (int c = 1; c < candidates_; ++c)
-    if (trial_seconds_[c] / trial_systems_[c] < trial_seconds_[best] / trial_systems_[best]) best = c;
+void SolverChoice::next_trial_candidate() {
+  for (int c = 0; c < candidates_; ++c)
+    if (trial_cost_[c] < 0.0) {
+      on_trial_ = next_ = c;
+      return;
+    }
+  // Every candidate measured: the cheapest is chosen.
+  const int best = cheapest();
   const bool confirmed = trials_ > 0 && best == chosen_;
   if (trials_ > 0 && best != chosen_) ++switches_;
   ++trials_;
-  // A confirmed choice is checked half as often from now on; a new one as often as at first.
-  interval_ = confirmed ? std::min(2 * interval_, settings_.max_recheck_systems) : settings_.recheck_systems;
-  chosen_ = best;
-  next_ = best;
-  reference_ = recent_ = trial_seconds_[best] / trial_systems_[best];
+  // The margin: how many times the winner's cost the closest loser's step cost (at least; a
+  // stopped one's is a lower bound).
+  margin_ = 0.0;
+  for (int c = 0; c < candidates_; ++c)
+    if (c != best && trial_cost_[best] > 0.0)
+      margin_ = margin_ == 0.0 ? trial_cost_[c] / trial_cost_[best] : std::min(margin_, trial_cost_[c] / trial_cost_[best]);
+  margin_ = std::max(margin_, 1.0);
+  // A confirmed choice is checked half as often from now on; a new one as often as at first; and
+  // never so often that the losers' trial steps cost more than `Trial overhead` of the winner's.
+  interval_ = confirmed ? std::min(2 * interval_, settings_.max_recheck_steps) : settings_.recheck_steps;
+  const double affordable = std::ceil((margin_ - 1.0) / settings_.trial_overhead);
+  interval_ = std::max(interval_, static_cast<int>(std::min<double>(affordable, settings_.max_recheck_steps)));
+  chosen_ = next_ = best;
+  reference_ = recent_ = trial_cost_[best];
   since_trial_ = 0;
   in_trial_ = false;
 }

@@ -4,6 +4,7 @@
 schema, the XDMF index ParaView opens, and solver.csv."""
 import csv
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -171,6 +172,28 @@ if os.path.exists(snow_frame):
         check(np.linalg.det(F_P).min() < 0.99, "plastic compression: J_P < 1")
         check(np.allclose(p["left_cauchy_green_elastic"][...], F_E @ np.transpose(F_E, (0, 2, 1)), atol=1e-12),
               "b^E = F_E F_E^T")
+
+# The measured choice: the summary says, once, how many Newton systems each candidate solved, and
+# they add up to the run's Newton iterations; solver.csv names each solve's candidate: the first
+# step solving anything is the first candidate's trial, the next starts the second's.
+choice_out = os.path.join(args.workdir, "choice")
+result = run(scene, "--output", choice_out, "--frames", "2", *small, "--solver",
+             os.path.join(args.inputs, "solvers", "measured_choice_cg.xml"))
+check(result.returncode == 0, f"measured choice run exits 0, got {result.returncode}: {result.stderr[-2000:]}")
+summary = [line for line in result.stdout.splitlines() if line.startswith("measured-choice:")]
+check(len(summary) == 1, f"one summary line of the measured choice: {summary}")
+if len(summary) == 1 and "Newton iterations" in result.stdout:
+    counts = re.findall(r"(matrix-free-jacobi|gmg-lean-deflated) (\d+) systems", summary[0])
+    newton_total = int(result.stdout.split("Newton iterations")[0].split(",")[-1])
+    check(len(counts) == 2 and all(int(n) >= 1 for _, n in counts) and sum(int(n) for _, n in counts) == newton_total,
+          f"both candidates solved systems, {newton_total} in all: {summary[0]}")
+    with open(os.path.join(choice_out, "solver.csv")) as f:
+        rows = list(csv.DictReader(f))
+    steps = sorted({int(r["step"]) for r in rows})
+    first = [r["preconditioner"] for r in rows if int(r["step"]) == steps[0]]
+    second = [r["preconditioner"] for r in rows if len(steps) > 1 and int(r["step"]) == steps[1]]
+    check(set(first) == {"gmg-lean-deflated"} and second[:1] == ["matrix-free-jacobi"],
+          f"the trials: a step of the first candidate, then the second's: {first}, {second}")
 
 # A run that fails keeps the frames written so far: exit 3.
 failed_out = os.path.join(args.workdir, "failed")

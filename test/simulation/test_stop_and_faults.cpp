@@ -72,6 +72,27 @@ materials::MaterialList breaking_materials(const scene::SceneConfig& scene, doub
   for (auto& m : list) m = std::make_unique<BreaksAtLargeSteps>(std::move(m), limit);
   return list;
 }
+
+// A checkpoint resets what the solver reuses across steps, as a restart starts afresh: the
+// reference writes one after every step (wall-clock checkpoints every 1e-9 s), and so does the
+// run that is stopped and restarted.
+scene::SceneConfig every_step(scene::SceneConfig scene) {
+  scene.output.checkpoint_wall_seconds = 1e-9;
+  return scene;
+}
+
+// The short run never stopped, checkpointed after every step: its particles, gathered, and steps.
+struct ReferenceRun {
+  std::map<ParticleId, testkit::ParticleState> particles;
+  std::int64_t steps;
+};
+ReferenceRun reference_run(const std::string& dir, const linalg::SolverConfiguration& solver,
+                           const parallel::Communicator& world) {
+  std::ostringstream log;
+  simulation::Simulation straight(every_step(short_run(dir + "/straight")), solver, world);
+  EXPECT_EQ(straight.run(log).stop_signal, 0);
+  return {testkit::gather_particles(straight.particles(), world.comm()), straight.step_count()};
+}
 }  // namespace
 
 TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitForBit) {
@@ -80,17 +101,8 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   const auto solver = testkit::jacobi_cg(1e-12);
   std::ostringstream log;
 
-  // A checkpoint resets what the solver reuses across steps, as a restart starts afresh: the
-  // reference writes one after every step (wall-clock checkpoints every 1e-9 s), and so does the
-  // run that is stopped and restarted.
-  auto every_step = [](scene::SceneConfig scene) {
-    scene.output.checkpoint_wall_seconds = 1e-9;
-    return scene;
-  };
-  simulation::Simulation straight(every_step(short_run(dir + "/straight")), solver, world);
-  const auto done = straight.run(log);
-  EXPECT_EQ(done.stop_signal, 0);
-  const auto reference = testkit::gather_particles(straight.particles(), world.comm());
+  const auto straight = reference_run(dir, solver, world);
+  const auto& reference = straight.particles;
 
   // SIGTERM reaches the last rank only, before the first step: every rank abandons that step at
   // its first Newton iteration and checkpoints the state before it.
@@ -114,7 +126,7 @@ TEST(StopRequest, ASignalOnOneRankStopsEveryRankWithACheckpointThatContinuesBitF
   EXPECT_EQ(continued.time(), stopped.time());
   const auto rest = continued.run(log);
   EXPECT_EQ(rest.stop_signal, 0);
-  EXPECT_EQ(continued.step_count(), straight.step_count());
+  EXPECT_EQ(continued.step_count(), straight.steps);
   const auto result = testkit::gather_particles(continued.particles(), world.comm());
   EXPECT_TRUE(testkit::bitwise_equal(reference, result)) << "difference " << testkit::max_state_difference(reference, result);
   if (world.is_root()) EXPECT_EQ(files_starting_with(dir + "/stopped", "frame_").size(), 4u);
@@ -285,13 +297,8 @@ TEST(StopRequest, DuringAFramesFileRemovesThePartialFileAndStopsEveryRank) {
   const std::string dir = testkit::work_directory(world, "stop_during_frame");
   const auto solver = testkit::jacobi_cg(1e-12);
   std::ostringstream log;
-  auto every_step = [](scene::SceneConfig scene) {
-    scene.output.checkpoint_wall_seconds = 1e-9;
-    return scene;
-  };
-  simulation::Simulation straight(every_step(short_run(dir + "/straight")), solver, world);
-  ASSERT_EQ(straight.run(log).stop_signal, 0);
-  const auto reference = testkit::gather_particles(straight.particles(), world.comm());
+  const auto straight = reference_run(dir, solver, world);
+  const auto& reference = straight.particles;
 
   install_stop_handlers();
   clear_stop_signal();
@@ -319,7 +326,7 @@ TEST(StopRequest, DuringAFramesFileRemovesThePartialFileAndStopsEveryRank) {
   simulation::Simulation continued(every_step(short_run(dir + "/stopped")), solver, world, summary.stop_checkpoint);
   const auto rest = continued.run(log);
   EXPECT_EQ(rest.stop_signal, 0);
-  EXPECT_EQ(continued.step_count(), straight.step_count());
+  EXPECT_EQ(continued.step_count(), straight.steps);
   const auto result = testkit::gather_particles(continued.particles(), world.comm());
   EXPECT_TRUE(testkit::bitwise_equal(reference, result)) << "difference " << testkit::max_state_difference(reference, result);
   for (int frame = 0; frame <= 3; ++frame)

@@ -23,13 +23,13 @@ struct LinearSolveReport {
 };
 
 /// A measured choice between solver files (a solver file with `Choose between`): how its trials
-/// are scheduled, counted in Newton systems (newton::SolverChoice; doc/solvers.md).
+/// are scheduled, counted in time steps (newton::SolverChoice; doc/solvers.md).
 struct SolverChoiceSettings {
-  int trial_systems = 1;          ///< Newton systems each candidate solves in a trial
-  int recheck_systems = 16;       ///< systems of the chosen one before the next trial (doubled when confirmed)
-  int max_recheck_systems = 256;  ///< the longest interval between trials
-  double regime_change = 2.0;     ///< a trial at once when the chosen one's cost per system moves by this factor
-  int regime_systems = 4;         ///< systems after a trial before a regime change is looked for
+  int recheck_steps = 16;       ///< steps of the chosen one before the next trial (doubled when confirmed)
+  int max_recheck_steps = 256;  ///< the longest interval between trials
+  double regime_change = 2.0;   ///< a trial at once when the chosen one's cost per step moves by this factor
+  int regime_steps = 4;         ///< steps after a trial before a regime change is looked for
+  double trial_overhead = 0.05; ///< the losers' trials cost at most this share of the winner's steps
 };
 
 class SolverConfiguration {

@@ -65,7 +65,7 @@ class NewtonSolver {
   /// On the simulation's system.
   NewtonSolver(const NewtonSettings& settings, linalg::NewtonSystem& system, const parallel::Communicator& comm);
   /// On a measured choice's candidates: each Newton direction is computed with the one
-  /// SolverChoice names, timed for it (seconds per decade of residual reduction of its solve).
+  /// SolverChoice names, timed for it.
   NewtonSolver(const NewtonSettings& settings, const std::vector<linalg::NewtonSystem*>& candidates,
                const linalg::SolverChoiceSettings& choice, const parallel::Communicator& comm);
   /// On any system (tests); `system` must outlive the solver.
