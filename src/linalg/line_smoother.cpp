@@ -59,6 +59,7 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
     }
   }
   factors_.resize(lines_.size());
+  indefinite_lines_ = 0;
   for (std::size_t l = 0; l < lines_.size(); ++l) {
     const Eigen::MatrixXd& block = blocks[l];
     BandFactor& f = factors_[l];
@@ -73,7 +74,19 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
       for (int i = j; i <= std::min(f.rows - 1, j + f.bandwidth); ++i) f.band[j * ld + (i - j)] = block(i, j);
     int info = 0;
     dpbtrf_("L", &f.rows, &f.bandwidth, f.band.data(), &ld, &info);
-    if (info != 0) throw std::runtime_error("LineSmoother: a line's block of H is not positive definite");
+    if (info != 0) {
+      // No Cholesky factor: H assembled unprojected (Newton's first attempt under adaptive
+      // projection) is indefinite on this line. The smoother must stay SPD for CG, so the line is
+      // smoothed by |diag H| (Jacobi); whether CG can use H itself is Newton's to find out.
+      const double largest = block.diagonal().cwiseAbs().maxCoeff();
+      f.bandwidth = 0;
+      f.band.resize(static_cast<std::size_t>(f.rows));
+      for (int j = 0; j < f.rows; ++j) {
+        const double d = std::abs(block(j, j));
+        f.band[j] = std::sqrt(d > 1e-12 * largest ? d : (largest > 0.0 ? largest : 1.0));
+      }
+      ++indefinite_lines_;
+    }
   }
   // The damping: Line damping over λmax(S A), by power iterations.
   damping_ = 1.0;

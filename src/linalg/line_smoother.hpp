@@ -4,6 +4,8 @@
 // 3 × Line length rows, nodes coupled to the next two along the line, so a band of 8 below the
 // diagonal) and applied as one pass of banded solves (dpbtrs), summed over the overlapping lines:
 //   y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x,   ω = Line damping / λmax(Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ A).
+// A line whose block is not positive definite (H assembled unprojected can be indefinite) uses
+// B_ℓ = |diag| of its block, so that the smoother stays SPD.
 // The same blocks as Ifpack2's BLOCK_RELAXATION with user parts, without its per-application
 // copies into containers, weights and residual (measured: doc/performance.md). Private to src/linalg.
 #pragma once
@@ -32,6 +34,9 @@ class LineSmoother {
   /// y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x on the owned dofs.
   void apply(const multivector_type& x, multivector_type& y) const;
   double damping() const { return damping_; }
+  /// Lines of the last compute whose block had no Cholesky factor (H indefinite there), smoothed
+  /// by |diag H| instead.
+  int indefinite_lines() const { return indefinite_lines_; }
 
  private:
   /// y += Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x for column j (no damping).
@@ -45,6 +50,7 @@ class LineSmoother {
   std::vector<std::vector<std::size_t>> lines_;
   std::vector<BandFactor> factors_;
   double damping_ = 1.0;
+  int indefinite_lines_ = 0;
   Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate
 };
 
