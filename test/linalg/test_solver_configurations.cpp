@@ -321,6 +321,24 @@ TEST(SolverConfigurations, TheLeanCycleOnAOneLevelHierarchyIsMueLusCoarseSolver)
   EXPECT_EQ(lean_report.iterations, muelu_report.iterations);
 }
 
+namespace {
+// ⟨x, M y⟩ = ⟨M x, y⟩ and ⟨x, M x⟩ > 0 for the system's preconditioner M on three pairs of random
+// vectors (seeded by `seed` and the rank).
+void expect_spd_preconditioner(StiffSystem& system, const parallel::Communicator& world, int seed, const std::string& label) {
+  auto& newton = system.sim.integrator().newton_system();
+  std::mt19937 rng(seed + world.rank());
+  for (int trial = 0; trial < 3; ++trial) {
+    const NodeVectorField x = random_field(system.sim, rng), y = random_field(system.sim, rng);
+    NodeVectorField mx, my;
+    newton.apply_preconditioner(x, mx);
+    newton.apply_preconditioner(y, my);
+    const double xmy = dot(system.sim, x, my, world), mxy = dot(system.sim, mx, y, world);
+    EXPECT_NEAR(xmy, mxy, 1e-8 * std::sqrt(dot(system.sim, mx, mx, world) * dot(system.sim, y, y, world))) << label;
+    EXPECT_GT(dot(system.sim, x, mx, world), 0.0) << label;
+  }
+}
+}  // namespace
+
 TEST(SolverConfigurations, TheDeflatedLeanCycleIsSymmetricPositiveDefinite) {
   // CG needs an SPD preconditioner: ⟨x, M y⟩ = ⟨M x, y⟩ and ⟨x, M x⟩ > 0 on random vectors, for
   // the lean cycle alone and deflated by the stiff bodies' rigid motions (the balancing form is
@@ -330,18 +348,7 @@ TEST(SolverConfigurations, TheDeflatedLeanCycleIsSymmetricPositiveDefinite) {
     StiffSystem system(with_parameter("gmg_lean_deflated_cg.xml", "Deflation", deflation),
                        world);
     system.assemble(1.0 / 24.0);
-    auto& newton = system.sim.integrator().newton_system();
-    std::mt19937 rng(11 + world.rank());
-    for (int trial = 0; trial < 3; ++trial) {
-      const NodeVectorField x = random_field(system.sim, rng), y = random_field(system.sim, rng);
-      NodeVectorField mx, my;
-      newton.apply_preconditioner(x, mx);
-      newton.apply_preconditioner(y, my);
-      const double xmy = dot(system.sim, x, my, world), mxy = dot(system.sim, mx, y, world);
-      EXPECT_NEAR(xmy, mxy, 1e-8 * std::sqrt(dot(system.sim, mx, mx, world) * dot(system.sim, y, y, world)))
-          << deflation;
-      EXPECT_GT(dot(system.sim, x, mx, world), 0.0) << deflation;
-    }
+    expect_spd_preconditioner(system, world, 11, deflation);
   }
 }
 
@@ -364,17 +371,7 @@ TEST(SolverConfigurations, TheLeanCycleSetsUpOnAnIndefiniteHessian) {
   EXPECT_FALSE(indefinite.converged && indefinite.relative_residual > indefinite.tolerance) << "claims a convergence it did not reach";
 
   ASSERT_NO_THROW(system.assemble(1.0 / 24.0, /*project=*/true));
-  auto& newton = system.sim.integrator().newton_system();
-  std::mt19937 rng(17 + world.rank());
-  for (int trial = 0; trial < 3; ++trial) {
-    const NodeVectorField x = random_field(system.sim, rng), y = random_field(system.sim, rng);
-    NodeVectorField mx, my;
-    newton.apply_preconditioner(x, mx);
-    newton.apply_preconditioner(y, my);
-    const double xmy = dot(system.sim, x, my, world), mxy = dot(system.sim, mx, y, world);
-    EXPECT_NEAR(xmy, mxy, 1e-8 * std::sqrt(dot(system.sim, mx, mx, world) * dot(system.sim, y, y, world)));
-    EXPECT_GT(dot(system.sim, x, mx, world), 0.0);
-  }
+  expect_spd_preconditioner(system, world, 17, "projected");
   const auto projected = system.solve();
   EXPECT_TRUE(projected.converged) << projected.failure;
   EXPECT_LT(projected.relative_residual, 1e-5);
