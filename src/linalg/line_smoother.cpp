@@ -59,7 +59,6 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
     }
   }
   factors_.resize(lines_.size());
-  indefinite_lines_ = 0;
   for (std::size_t l = 0; l < lines_.size(); ++l) {
     const Eigen::MatrixXd& block = blocks[l];
     BandFactor& f = factors_[l];
@@ -85,7 +84,6 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
         const double d = std::abs(block(j, j));
         f.band[j] = std::sqrt(d > 1e-12 * largest ? d : (largest > 0.0 ? largest : 1.0));
       }
-      ++indefinite_lines_;
     }
   }
   // The damping: Line damping over λmax(S A), by power iterations.

@@ -34,9 +34,6 @@ class LineSmoother {
   /// y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x on the owned dofs.
   void apply(const multivector_type& x, multivector_type& y) const;
   double damping() const { return damping_; }
-  /// Lines of the last compute whose block had no Cholesky factor (H indefinite there), smoothed
-  /// by |diag H| instead.
-  int indefinite_lines() const { return indefinite_lines_; }
 
  private:
   /// y += Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x for column j (no damping).
@@ -50,7 +47,6 @@ class LineSmoother {
   std::vector<std::vector<std::size_t>> lines_;
   std::vector<BandFactor> factors_;
   double damping_ = 1.0;
-  int indefinite_lines_ = 0;
   Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate
 };
 
