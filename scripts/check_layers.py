@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The layer rule of doc/architecture.md, checked: every #include "viscompm/<folder>/..." in
 src/<folder>/, include/viscompm/<folder>/ and apps/ must name a folder that <folder> may include,
 and the physics folders include no Trilinos or HDF5 header. Prints one line per violation and

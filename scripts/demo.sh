@@ -4,6 +4,7 @@
 # VISCOMPM_RANKS (a positive whole number) is checked before anything is built, the options by
 # viscompm (one line naming the option, exit 2).
 set -euo pipefail
+case "${1:-}" in -h|--help) sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
 RANKS="${VISCOMPM_RANKS:-$(nproc)}"
 [[ "$RANKS" =~ ^[1-9][0-9]{0,4}$ ]] || { echo "demo.sh: VISCOMPM_RANKS='$RANKS' is not a positive whole number" >&2; exit 2; }
 source "$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/setup.sh"

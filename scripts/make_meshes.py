@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Writes the meshes of the paper scenes (inputs/meshes/), made here from primitives; nothing is
 downloaded. Both are closed, consistently oriented triangle meshes (outward normals), y up.
 

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Measures, from a run's frames, the behaviour each paper scene (thesis §5.6) is about.
 
 Usage: scripts/measure_scenes.py OUTPUT_DIR [--scene NAME] [--scene-file XML] [--json FILE]

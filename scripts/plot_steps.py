@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Plot a viscompm-study steps.csv: wall seconds per frame of each configuration, split into the
 phases of the Newton solve (operator preparation, preconditioner set-up, CG, line search) and the
 rest of the step, with Newton and CG iteration counts (one bar per configuration and cell size). Usage: plot_steps.py steps.csv steps.png

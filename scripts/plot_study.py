@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Plot a viscompm-study CSV: iterations and time to solution (set-up + solve) against unknowns,
 one line per preconditioner and time step. Usage: plot_study.py study.csv study.png
 

@@ -10,7 +10,10 @@ BUILD_DIR="${VISCOMPM_BUILD_DIR:-$VISCOMPM_ROOT/build}"
 JOBS="${VISCOMPM_JOBS:-$(nproc)}"
 setup_fail() { echo "setup.sh: $*" >&2; exit 2; }
 # Sourced, "$@" are the caller's arguments: only a script run by itself has none to take.
-if [ "${BASH_SOURCE[0]}" = "$0" ] && [ $# -gt 0 ]; then setup_fail "takes no arguments, got '$1'"; fi
+if [ "${BASH_SOURCE[0]}" = "$0" ] && [ $# -gt 0 ]; then
+  case "$1" in -h|--help) sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
+  setup_fail "takes no arguments, got '$1'"
+fi
 [[ "$JOBS" =~ ^[1-9][0-9]{0,3}$ ]] || setup_fail "VISCOMPM_JOBS='$JOBS' is not a positive whole number"
 mkdir -p "$BUILD_DIR" 2>/dev/null || setup_fail "VISCOMPM_BUILD_DIR: cannot make the directory $BUILD_DIR"
 [ -w "$BUILD_DIR" ] || setup_fail "VISCOMPM_BUILD_DIR: cannot write to $BUILD_DIR"

@@ -18,6 +18,7 @@ sanitize=0
 ctest_help=""
 for argument in "$@"; do
   case "$argument" in
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     --sanitize) sanitize=1 ;;
     --no-trilinos) export VISCOMPM_BUILD_TARGET=no_trilinos_tests; ctest_args+=(-L no_trilinos) ;;
     -*)

@@ -233,5 +233,30 @@ else:
         directory, path = damaged(name, data, build)
         bad(f"render.sh: {what}", render + [directory, "--style", "spheres", "--size", "64x48", "--no-movie"], path)
 
+# ---------------------------------------------------------------------------------------------
+# Every program under scripts/ runs by its own name, as the docs write it (scripts/NAME --help):
+# executable, its interpreter the one scripts/setup.sh installs the modules for (Debian's
+# /usr/bin/python3, not the first python3 on PATH), and --help answered with its usage, exit 0,
+# nothing built (a build directory given in the environment is not made).
+not_built = os.path.join(work, "no_build_for_help")
+for name in sorted(os.listdir(scripts)):
+    path = os.path.join(scripts, name)
+    if not os.path.isfile(path):
+        continue
+    with open(path, "rb") as f:
+        first_line = f.readline().decode(errors="replace").strip()
+    if not first_line.startswith("#!"):
+        continue  # a module run by another program (render_frames.py under pvbatch)
+    counted["cases"] += 1
+    check(os.access(path, os.X_OK), f"{name}: executable (it starts with '{first_line}')")
+    if name.endswith(".py"):
+        check(first_line == "#!/usr/bin/python3", f"{name}: runs under /usr/bin/python3, not '{first_line}'")
+    result = run([path, "--help"], env={"VISCOMPM_BUILD_DIR": not_built}, timeout=60)
+    ok = result.returncode == 0 and len(result.stdout.strip().splitlines()) >= 2 and not os.path.exists(not_built)
+    check(result.returncode == 0, f"{name} --help: exit 0, got {result.returncode}: {result.stderr[-800:]}")
+    check(len(result.stdout.strip().splitlines()) >= 2, f"{name} --help: its usage on stdout: {result.stdout[-400:]}")
+    check(not os.path.exists(not_built), f"{name} --help: nothing built")
+    print(f"{'ok  ' if ok else 'FAIL'} {name} --help by its own name")
+
 finish(f"{counted['cases']} script cases answered as the contract says"
        + (" (render.sh on frames skipped)" if counted["skipped"] else ""))
