@@ -30,7 +30,9 @@ What is measured (doc/scenes.md, "Measured behaviour"):
                      (splitting), the crust's velocity along the throw by frame (does it reach the
                      head?) (Figures 5.6, 5.8)
   twisting_sponge    separated pieces and torn links (lattice neighbours now far apart: the torn
-                     area), the grips' turn (Figure 5.1)
+                     area), the grips' turn, whether it came apart (at least 2 pieces of more
+                     than 1 % of the particles each), when it first did, and each piece's height
+                     range (torn in the middle or off a grip?) (Figure 5.1)
   shooting_sponge    the sponge's deformation (rms displacement from frame 0: its peak and how far
                      it comes back after the bullet has passed: the recovery), the bullet's tunnel
                      (particles in its path relative to frame 0), pieces, torn links (Figure 5.2)
@@ -526,6 +528,23 @@ def measure_twisting(frames, scene, link_factor, tear_factor):
     result["torn_fraction_by_frame"] = [
         [round(frames.frame(n)["time"], 3), round(torn_links(first, frames.frame(n), spacing(first), tear_factor)["torn_fraction"], 4)]
         for n in frames.numbers[:: max(1, len(frames.numbers) // 8)]]
+    # Came apart: at least two pieces of more than 1 % of the particles each (a tear through the
+    # whole cross-section leaves two such pieces); the first frame where it holds, and where along
+    # the grips' axis (y) each piece of the last frame lies, lowest first.
+    h, n = spacing(first), len(first["position"])
+
+    def large_pieces(frame):
+        labels, _ = components(frame["position"], link_factor * h)
+        sizes = np.bincount(labels)
+        return labels, [q for q in np.argsort(-sizes) if sizes[q] > n // 100]
+
+    labels, large = large_pieces(last)
+    result["pieces_over_1_percent"] = len(large)
+    result["came_apart"] = len(large) >= 2
+    result["piece_height_ranges"] = sorted([round(float(last["position"][labels == q, 1].min()), 3),
+                                      round(float(last["position"][labels == q, 1].max()), 3)] for q in large)
+    result["first_apart_time"] = next((round(float(frames.frame(k)["time"]), 4) for k in frames.numbers
+                                       if len(large_pieces(frames.frame(k))[1]) >= 2), None)
     return result
 
 

@@ -222,6 +222,30 @@ if m:
     across = int(np.sum(~upper & (block[:, 1] > 4.25 - h)))  # one link across the plane per column
     check(m["pieces"] == 2, f"sponge: 2 pieces, got {m['pieces']}")
     check(m["torn_links"] == across, f"sponge: {across} torn links, got {m['torn_links']}")
+    check(m["came_apart"] and m["pieces_over_1_percent"] == 2, f"sponge: came apart in 2 pieces: {m}")
+    check(m["first_apart_time"] == 1.0, f"sponge: first apart at 1.0 s, got {m['first_apart_time']}")
+    check(m["piece_height_ranges"][0][1] < 4.25 < m["piece_height_ranges"][1][0],
+          f"sponge: the pieces lie on either side of the plane: {m['piece_height_ranges']}")
+# The same block with only a column of particles along one edge (under 1 % of them) torn off at 0.5 s and
+# the whole cut at 1.0 s: it came apart, first at 1.0 s; with no cut at all it did not.
+d = os.path.join(args.workdir, "sponge_sliver")
+write_frame(d, 0, 0.0, block, np.zeros(len(block)), ["sponge"], spacing=h)
+sliver = block.copy()
+top = (sliver[:, 0] > 5.2335 - h) & (sliver[:, 2] > 5.2335 - h)
+sliver[top, 0] += 3 * h
+write_frame(d, 1, 0.5, sliver, np.zeros(len(block)), ["sponge"], spacing=h)
+write_frame(d, 2, 1.0, torn, np.zeros(len(block)), ["sponge"], spacing=h)
+m = measure(d, "twisting_sponge", os.path.join(paper, "twisting_sponge.xml"))
+if m:
+    check(0 < top.sum() < len(block) // 100, "sponge: the sliver is under 1 % of the particles")
+    check(m["first_apart_time"] == 1.0, f"sponge: a sliver torn off is not apart; first apart at 1.0 s, got {m['first_apart_time']}")
+d = os.path.join(args.workdir, "sponge_whole")
+write_frame(d, 0, 0.0, block, np.zeros(len(block)), ["sponge"], spacing=h)
+write_frame(d, 1, 1.0, sliver, np.zeros(len(block)), ["sponge"], spacing=h)
+m = measure(d, "twisting_sponge", os.path.join(paper, "twisting_sponge.xml"))
+if m:
+    check(not m["came_apart"] and m["first_apart_time"] is None and m["pieces_over_1_percent"] == 1,
+          f"sponge: with a sliver torn off it did not come apart: {m}")
 # The error contract: a bad or missing argument, a missing directory or scene file and a damaged
 # frame are each answered with one line on stderr naming the option or the file, a non-zero exit
 # and nothing on stdout (no traceback).
