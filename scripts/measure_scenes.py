@@ -531,20 +531,20 @@ def measure_twisting(frames, scene, link_factor, tear_factor):
     # Came apart: at least two pieces of more than 1 % of the particles each (a tear through the
     # whole cross-section leaves two such pieces); the first frame where it holds, and where along
     # the grips' axis (y) each piece of the last frame lies, lowest first.
-    h, n = spacing(first), len(first["position"])
+    link, over_1_percent = link_factor * spacing(first), len(first["position"]) // 100 + 1
 
-    def large_pieces(frame):
-        labels, _ = components(frame["position"], link_factor * h)
-        sizes = np.bincount(labels)
-        return labels, [q for q in np.argsort(-sizes) if sizes[q] > n // 100]
+    def apart(frame):
+        return len(pieces(components(frame["position"], link)[0], over_1_percent)) >= 2
 
-    labels, large = large_pieces(last)
+    labels, _ = components(last["position"], link)
+    sizes = np.bincount(labels)
+    large = [q for q in range(len(sizes)) if sizes[q] >= over_1_percent]
     result["pieces_over_1_percent"] = len(large)
     result["came_apart"] = len(large) >= 2
     result["piece_height_ranges"] = sorted([round(float(last["position"][labels == q, 1].min()), 3),
-                                      round(float(last["position"][labels == q, 1].max()), 3)] for q in large)
+                                            round(float(last["position"][labels == q, 1].max()), 3)] for q in large)
     result["first_apart_time"] = next((round(float(frames.frame(k)["time"]), 4) for k in frames.numbers
-                                       if len(large_pieces(frames.frame(k))[1]) >= 2), None)
+                                       if apart(frames.frame(k))), None)
     return result
 
 

@@ -252,11 +252,12 @@ for name in sorted(os.listdir(scripts)):
     if name.endswith(".py"):
         check(first_line == "#!/usr/bin/python3", f"{name}: runs under /usr/bin/python3, not '{first_line}'")
     result = run([path, "--help"], env={"VISCOMPM_BUILD_DIR": not_built}, timeout=60)
-    ok = result.returncode == 0 and len(result.stdout.strip().splitlines()) >= 2 and not os.path.exists(not_built)
-    check(result.returncode == 0, f"{name} --help: exit 0, got {result.returncode}: {result.stderr[-800:]}")
-    check(len(result.stdout.strip().splitlines()) >= 2, f"{name} --help: its usage on stdout: {result.stdout[-400:]}")
-    check(not os.path.exists(not_built), f"{name} --help: nothing built")
-    print(f"{'ok  ' if ok else 'FAIL'} {name} --help by its own name")
+    exits_0, usage, nothing_built = (result.returncode == 0, len(result.stdout.strip().splitlines()) >= 2,
+                                     not os.path.exists(not_built))
+    check(exits_0, f"{name} --help: exit 0, got {result.returncode}: {result.stderr[-800:]}")
+    check(usage, f"{name} --help: its usage on stdout: {result.stdout[-400:]}")
+    check(nothing_built, f"{name} --help: nothing built")
+    print(f"{'ok  ' if exits_0 and usage and nothing_built else 'FAIL'} {name} --help by its own name")
 
 finish(f"{counted['cases']} script cases answered as the contract says"
        + (" (render.sh on frames skipped)" if counted["skipped"] else ""))
