@@ -63,13 +63,16 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# A private X display that does not reset between clients (ParaView's OpenGL needs one).
-display=90
-while [ -e "/tmp/.X${display}-lock" ] || [ -e "/tmp/.X11-unix/X${display}" ]; do display=$((display + 1)); done
-Xvfb ":${display}" -screen 0 1920x1080x24 -nolisten tcp -noreset >/dev/null 2>&1 &
+# A private X display that does not reset between clients (ParaView's OpenGL needs one). Xvfb
+# picks a free display number itself and writes it once it accepts clients (-displayfd), so two
+# renders started together cannot take the same display (and the first to end kill the other's).
+display_file="$(mktemp)"
+Xvfb -displayfd 3 -screen 0 1920x1080x24 -nolisten tcp -noreset 3>"$display_file" >/dev/null 2>&1 &
 xvfb_pid=$!
-trap 'kill "$xvfb_pid" 2>/dev/null || true' EXIT
-for _ in $(seq 100); do [ -S "/tmp/.X11-unix/X${display}" ] && break; sleep 0.1; done
+trap 'kill "$xvfb_pid" 2>/dev/null || true; rm -f "$display_file"' EXIT
+for _ in $(seq 100); do [ -s "$display_file" ] && break; sleep 0.1; done
+display="$(head -n 1 "$display_file")"
+[ -n "$display" ] || { echo "render.sh: Xvfb did not start" >&2; exit 3; }
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 DISPLAY=":${display}" pvbatch "$here/render_frames.py" "$OUTPUT_DIR" "${forward[@]}" 2> >(grep -v -e '^\s*$' -e 'Warning' >&2)
