@@ -65,7 +65,7 @@ fi
 
 # A private X display that does not reset between clients (ParaView's OpenGL needs one). Xvfb
 # picks a free display number itself and writes it once it accepts clients (-displayfd), so two
-# renders started together cannot take the same display (and the first to end kill the other's).
+# renders started together cannot take the same display (where the first to end killed the other's).
 display_file="$(mktemp)"
 Xvfb -displayfd 3 -screen 0 1920x1080x24 -nolisten tcp -noreset 3>"$display_file" >/dev/null 2>&1 &
 xvfb_pid=$!
