@@ -16,8 +16,8 @@ Teuchos::Time& coarse_timer() { static Teuchos::Time& t = timer("viscompm: lean 
 }  // namespace
 
 LeanCycle::LeanCycle(Teuchos::RCP<const operator_type> A, std::shared_ptr<const LineSmoother> smoother,
-                     Teuchos::RCP<muelu_hierarchy_type> hierarchy)
-    : A_(std::move(A)), smoother_(std::move(smoother)), hierarchy_(std::move(hierarchy)) {
+                     Teuchos::RCP<muelu_hierarchy_type> hierarchy, int sweeps)
+    : A_(std::move(A)), smoother_(std::move(smoother)), hierarchy_(std::move(hierarchy)), sweeps_(sweeps) {
   const auto level = hierarchy_->GetLevel(1);
   P_ = muelu_utilities_type::Op2TpetraCrs(level->template Get<Teuchos::RCP<xpetra_matrix_type>>("P"));
   R_ = muelu_utilities_type::Op2TpetraCrs(level->template Get<Teuchos::RCP<xpetra_matrix_type>>("R"));
@@ -29,11 +29,23 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
   multivector_type x(A_->getDomainMap(), k), residual(A_->getRangeMap(), k), correction(A_->getDomainMap(), k);
   auto coarse_b = Teuchos::rcp(new multivector_type(R_->getRangeMap(), k));
   auto coarse_x = Teuchos::rcp(new multivector_type(P_->getDomainMap(), k));
+  // One sweep of the smoother on x: x += S (X − A x).
+  const auto sweep = [&] {
+    {
+      Teuchos::TimeMonitor t(residual_timer());
+      A_->apply(x, residual);
+      residual.update(1.0, X, -1.0);
+    }
+    Teuchos::TimeMonitor t(smoother_timer());
+    smoother_->apply(residual, correction);
+    x.update(1.0, correction, 1.0);
+  };
   // Pre-smoothing from zero.
   {
     Teuchos::TimeMonitor t(smoother_timer());
     smoother_->apply(X, x);
   }
+  for (int s = 1; s < sweeps_; ++s) sweep();
   // Coarse correction of the residual.
   {
     Teuchos::TimeMonitor t(residual_timer());
@@ -54,17 +66,8 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
     Teuchos::TimeMonitor t(transfer_timer());
     P_->apply(*coarse_x, x, Teuchos::NO_TRANS, 1.0, 1.0);
   }
-  // Post-smoothing.
-  {
-    Teuchos::TimeMonitor t(residual_timer());
-    A_->apply(x, residual);
-    residual.update(1.0, X, -1.0);
-  }
-  {
-    Teuchos::TimeMonitor t(smoother_timer());
-    smoother_->apply(residual, correction);
-  }
-  x.update(1.0, correction, 1.0);
+  // Post-smoothing (the pre-smoothing's sweeps in reverse: the cycle stays symmetric).
+  for (int s = 0; s < sweeps_; ++s) sweep();
   Y.update(alpha, x, beta);
 }
 

@@ -1,6 +1,7 @@
 // The lean V-cycle (solver files: Cycle = lean): viscompm applies the fine level itself and hands
 // the levels below to the MueLu hierarchy it built,
 //   x = S r;  x += P · V₁(R (r − A x));  x += S (r − A x),
+// (with Fine sweeps = k, the first and the last step are k sweeps x += S (r − A x)),
 // with S the grid-line smoother (line_smoother.hpp), A the operator CG iterates with (assembled or
 // matrix-free), P and R level 1's prolongator and restrictor and V₁ one MueLu V-cycle from level 1
 // (Hierarchy::Iterate with startLevel 1). A fine level costs two products with A and two passes
@@ -18,7 +19,7 @@ namespace viscompm::linalg {
 class LeanCycle : public operator_type {
  public:
   LeanCycle(Teuchos::RCP<const operator_type> A, std::shared_ptr<const LineSmoother> smoother,
-            Teuchos::RCP<muelu_hierarchy_type> hierarchy);
+            Teuchos::RCP<muelu_hierarchy_type> hierarchy, int sweeps = 1);
 
   Teuchos::RCP<const map_type> getDomainMap() const override { return A_->getDomainMap(); }
   Teuchos::RCP<const map_type> getRangeMap() const override { return A_->getRangeMap(); }
@@ -30,6 +31,7 @@ class LeanCycle : public operator_type {
   Teuchos::RCP<const operator_type> A_;
   std::shared_ptr<const LineSmoother> smoother_;
   Teuchos::RCP<muelu_hierarchy_type> hierarchy_;
+  int sweeps_;  // smoother sweeps before and after the coarse correction
   Teuchos::RCP<const crs_matrix_type> P_, R_;
 };
 

@@ -61,6 +61,9 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
                 "MueLu: the hierarchy's V-cycle as MueLu applies it; lean: viscompm applies the fine level (the "
                 "grid-line smoother with its own factored blocks, the products with the operator CG uses) and "
                 "MueLu the levels below (needs Smoother blocks = grid lines)")
+        .integer(&S::fine_sweeps, "Fine sweeps", 1, Range::closed(1, 8),
+                 "lean cycle: grid-line smoother sweeps before and after the coarse correction (each sweep past "
+                 "the first costs one more product with the operator)")
         .choice(&S::deflation, "Deflation", Deflation::none,
                 {{"none", Deflation::none}, {"stiff bodies", Deflation::stiff_bodies}},
                 "stiff bodies: the 6 rigid motions of every stiff body (connected material whose elastic waves "

@@ -425,7 +425,7 @@ class MueLuPreconditioner : public Preconditioner {
     if (pattern_changed || !lean_lines_)
       lean_lines_ = std::make_shared<LineSmoother>(grid::node_lines(grid_of(modes)->owned_nodes, settings.line_length));
     lean_lines_->compute(A, *H.op(), settings.line_damping);
-    lean_ = Teuchos::rcp(new LeanCycle(H.op(), lean_lines_, prec_->GetHierarchy()));
+    lean_ = Teuchos::rcp(new LeanCycle(H.op(), lean_lines_, prec_->GetHierarchy(), settings.fine_sweeps));
   }
 
   // The block relaxations on grid lines (pre- and post-smoother, one object or two) get their

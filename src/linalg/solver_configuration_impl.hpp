@@ -44,6 +44,7 @@ struct SolverSettings {
   double line_damping = 1.5;
   int line_levels = 1;  ///< geometric hierarchies: the finest this many levels smooth on grid lines
   Cycle cycle = Cycle::muelu;
+  int fine_sweeps = 1;  ///< lean cycle: line-smoother sweeps before and after the coarse correction
   Deflation deflation = Deflation::none;
   double stiff_cfl = 30.0;    ///< c Δt/Δx from which a material counts as stiff (deflation)
   int max_stiff_bodies = 64;  ///< the largest this many bodies are deflated
