@@ -19,7 +19,8 @@ What is measured (doc/scenes.md, "Measured behaviour"):
   shaving_foam,      the stream laid on the ground: its turns around the nozzle's axis (coiling),
   toothpaste         its reversals along the main horizontal direction (S-shaped folding), the
                      pile's height and width, the laid material's median J = det F (crushed by its
-                     own weight?), and the loop-to-loop contacts: where a later turn or fold of
+                     own weight?) and the falling rope's J in four height bands from the nozzle
+                     down (where it is crushed), and the loop-to-loop contacts: where a later turn or fold of
                      the laid rope touches an earlier one, and how many of them fuse (a neck of at
                      least 1.5 rope radii across: merged, not resting on each other as distinct
                      ropes; see loop_contacts) (Figures 5.3, 5.9)
@@ -352,7 +353,15 @@ def measure_pile(frames, scene, bin_size, link_factor):
                    "fold_reversals": len(swings), "fold_amplitude_m": float(np.ptp(along) / 2),
                    "pile_height_by_frame_m": pile_heights(frames, speed)})
     if "deformation_gradient" in f:  # crushed by its own weight? J = det F of the laid material
-        result["laid_J_median"] = float(np.median(np.linalg.det(f["deformation_gradient"][laid])))
+        J = np.linalg.det(f["deformation_gradient"])
+        result["laid_J_median"] = float(np.median(J[laid]))
+        # Where it is crushed: J of the falling rope (moving down faster than 0.3 of the nozzle's
+        # speed) in four height bands from the nozzle down to the pile's base, the top band first
+        # (None: fewer than 10 particles in the band).
+        falling = v[:, 1] < -0.3 * speed
+        edges = np.linspace(float(centre[1]), base, 5)
+        bands = [falling & (x[:, 1] <= top) & (x[:, 1] > bottom) for top, bottom in zip(edges[:-1], edges[1:])]
+        result["falling_J_by_height"] = [float(np.median(J[b])) if b.sum() >= 10 else None for b in bands]
     index = np.nonzero(laid)[0]
     rank = np.empty(len(x), dtype=int)
     rank[index] = np.arange(len(index))

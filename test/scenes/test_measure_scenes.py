@@ -144,19 +144,37 @@ for label, path in (("coil", lambda s: 0.05 * np.stack([np.cos(6 * np.pi * s), n
         check(m["fold_reversals"] == 6, f"fold: 3.5 swings = 6 reversals, got {m['fold_reversals']}")
 
 # Toothpaste: 1.5 turns of a coil of radius 0.04 around a point 0.1 m beside the nozzle, rising as
-# it is laid, compressed to J = 0.5 (F = diag(1, 0.5, 1)) or not: the turns and the median J.
+# it is laid, compressed to J = 0.5 (F = diag(1, 0.5, 1)) or not: the turns and the median J. The
+# crushed one has a rope falling onto it from the nozzle (1.5 m, at 0.8 m/s down), 50 particles at
+# the middle of each of the four height bands between the nozzle and the pile's base, with
+# J = 1, 0.9, 0.8, 0.7 from the top: the falling rope's J by height.
 for label, squash in (("coil_offset", 1.0), ("coil_crushed", 0.5)):
     s = k / layers
     position = np.stack([nozzle[0] + 0.1 + 0.04 * np.cos(3 * np.pi * s), 1.0 + 0.1 * s,
                          nozzle[2] + 0.04 * np.sin(3 * np.pi * s)], axis=1) + 0.3 * jitter
+    F = np.tile(np.diag([1.0, squash, 1.0]), (len(k), 1, 1))
+    velocity = np.zeros((len(k), 3))
+    falling_J = [1.0, 0.9, 0.8, 0.7] if squash < 1 else []
+    if falling_J:
+        edges = np.linspace(nozzle[1], position[:, 1].min(), 5)
+        rope_y = np.repeat(0.5 * (edges[:-1] + edges[1:]), 50) + np.tile(np.linspace(-0.02, 0.02, 50), 4)
+        rope = np.stack([np.full(len(rope_y), nozzle[0]), rope_y, np.full(len(rope_y), nozzle[2])], axis=1)
+        position = np.concatenate([position, rope])
+        F = np.concatenate([F, np.array([np.diag([1.0, j, 1.0]) for j in np.repeat(falling_J, 50)])])
+        velocity = np.concatenate([velocity, np.tile([0.0, -0.8, 0.0], (len(rope), 1))])
     d = os.path.join(args.workdir, label)
     write_frame(d, 0, 0.0, position[:0], [], ["toothpaste"], spacing=0.01)
-    write_frame(d, 1, 2.0, position, np.zeros(len(k)), ["toothpaste"], spacing=0.01,
-                deformation_gradient=np.tile(np.diag([1.0, squash, 1.0]), (len(k), 1, 1)))
+    write_frame(d, 1, 2.0, position, np.zeros(len(position)), ["toothpaste"], velocity=velocity, spacing=0.01,
+                deformation_gradient=F)
     m = measure(d, "toothpaste", os.path.join(paper, "toothpaste.xml"))
     if m:
         check(abs(abs(m["coil_turns"]) - 1.5) < 0.3, f"{label}: 1.5 turns, got {m['coil_turns']}")
         check(abs(m.get("laid_J_median", 0) - squash) < 1e-9, f"{label}: median J {squash}, got {m.get('laid_J_median')}")
+        expected = falling_J or [None] * 4
+        got = m.get("falling_J_by_height")
+        check(got is not None and len(got) == 4 and all((e is None and g is None) or (e is not None and g is not None and abs(e - g) < 1e-9)
+                                                         for e, g in zip(expected, got)),
+              f"{label}: falling rope's J by height {expected}, got {got}")
 
 # Shaving foam: a rope of radius r = 5 spacings laid along x, turned around and laid back beside
 # itself (a racetrack: two straight arms 60 spacings long joined by a half circle), the arms'
