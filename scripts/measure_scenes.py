@@ -20,10 +20,10 @@ What is measured (doc/scenes.md, "Measured behaviour"):
   toothpaste         its reversals along the main horizontal direction (S-shaped folding), the
                      pile's height and width, the laid material's median J = det F (crushed by its
                      own weight?) and the falling rope's J in four height bands from the nozzle
-                     down (where it is crushed), and the loop-to-loop contacts: where a later turn or fold of
-                     the laid rope touches an earlier one, and how many of them fuse (a neck of at
-                     least 1.5 rope radii across: merged, not resting on each other as distinct
-                     ropes; see loop_contacts) (Figures 5.3, 5.9)
+                     down (where it is crushed), and the loop-to-loop contacts: where a later
+                     turn or fold of the laid rope touches an earlier one, and how many of them
+                     fuse (a neck of at least 1.5 rope radii across: merged, not resting on each
+                     other as distinct ropes; see loop_contacts) (Figures 5.3, 5.9)
   pie                crust pieces (connected components of crust particles) against the prescored
                      slices (the stiff crust's components at frame 0), slices broken across, the
                      groups of slices each piece holds and whether the crust broke along its cuts

@@ -29,29 +29,27 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
   multivector_type x(A_->getDomainMap(), k), residual(A_->getRangeMap(), k), correction(A_->getDomainMap(), k);
   auto coarse_b = Teuchos::rcp(new multivector_type(R_->getRangeMap(), k));
   auto coarse_x = Teuchos::rcp(new multivector_type(P_->getDomainMap(), k));
+  // residual = X − A x.
+  const auto form_residual = [&] {
+    Teuchos::TimeMonitor t(residual_timer());
+    A_->apply(x, residual);
+    residual.update(1.0, X, -1.0);
+  };
   // One sweep of the smoother on x: x += S (X − A x).
   const auto sweep = [&] {
-    {
-      Teuchos::TimeMonitor t(residual_timer());
-      A_->apply(x, residual);
-      residual.update(1.0, X, -1.0);
-    }
+    form_residual();
     Teuchos::TimeMonitor t(smoother_timer());
     smoother_->apply(residual, correction);
     x.update(1.0, correction, 1.0);
   };
-  // Pre-smoothing from zero.
+  // Pre-smoothing: the first sweep from zero (x = S X, no product), then the rest.
   {
     Teuchos::TimeMonitor t(smoother_timer());
     smoother_->apply(X, x);
   }
   for (int s = 1; s < sweeps_; ++s) sweep();
   // Coarse correction of the residual.
-  {
-    Teuchos::TimeMonitor t(residual_timer());
-    A_->apply(x, residual);
-    residual.update(1.0, X, -1.0);
-  }
+  form_residual();
   {
     Teuchos::TimeMonitor t(transfer_timer());
     R_->apply(residual, *coarse_b);
@@ -66,7 +64,7 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
     Teuchos::TimeMonitor t(transfer_timer());
     P_->apply(*coarse_x, x, Teuchos::NO_TRANS, 1.0, 1.0);
   }
-  // Post-smoothing (the pre-smoothing's sweeps in reverse: the cycle stays symmetric).
+  // Post-smoothing: as many sweeps as before (the cycle stays symmetric).
   for (int s = 0; s < sweeps_; ++s) sweep();
   Y.update(alpha, x, beta);
 }

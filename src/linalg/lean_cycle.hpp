@@ -1,11 +1,12 @@
 // The lean V-cycle (solver files: Cycle = lean): viscompm applies the fine level itself and hands
 // the levels below to the MueLu hierarchy it built,
 //   x = S r;  x += P · V₁(R (r − A x));  x += S (r − A x),
-// (with Fine sweeps = k, the first and the last step are k sweeps x += S (r − A x)),
 // with S the grid-line smoother (line_smoother.hpp), A the operator CG iterates with (assembled or
 // matrix-free), P and R level 1's prolongator and restrictor and V₁ one MueLu V-cycle from level 1
-// (Hierarchy::Iterate with startLevel 1). A fine level costs two products with A and two passes
-// of line solves: no smoother containers, no level-0 smoother object in MueLu. Symmetric (S and
+// (Hierarchy::Iterate with startLevel 1). With Fine sweeps = k, the smoothing before and after the
+// coarse correction is k sweeps x += S (r − A x) each (the first from x = 0). A fine level costs
+// 2k products with A and 2k passes of line solves: no smoother containers, no level-0 smoother
+// object in MueLu. Symmetric (S and
 // V₁ are, R = Pᵀ), so CG applies. Private to src/linalg.
 #pragma once
 
