@@ -31,7 +31,7 @@ struct NewtonSystem::Impl {
   std::uint64_t pattern_version = 0;               // the NodeSpace version of H's pattern
   std::optional<std::uint64_t> preconditioned_for;  // the pattern of the last preconditioner set-up
   NearNullspace modes;
-  Teuchos::RCP<multivector_type> stiff_modes;           // Deflation: Z of the last assembly (null: none)
+  Teuchos::RCP<crs_matrix_type> stiff_modes;            // Deflation: Z of the last assembly (null: none)
   Teuchos::RCP<DeflatedPreconditioner> deflated;        // the preconditioner with Z deflated
   int stiff_bodies = 0;
   bool last_assembly_projected = false;  // whether the last assembly projected H to PSD
@@ -81,14 +81,27 @@ void NewtonSystem::Impl::build_stiff_modes(const implicit::IncrementalPotential&
   }
   const auto& partition = space.partition();
   const std::size_t owned = space.impl().owned_count;
+  const int k = 6 * bodies.count;
   // Six modes per body: translations and rotations about its centroid (a body moves rigidly to
   // first order, the stiff elastic energy barely resists these modes and a local smoother cannot
-  // reach them: they are the slow components CG is left with).
-  stiff_modes = Teuchos::rcp(new multivector_type(space.impl().owned_dof_map, 6 * bodies.count));
-  auto z = stiff_modes->getLocalViewHost(Tpetra::Access::OverwriteAll);
-  for (std::size_t i = 0; i < z.extent(0); ++i)
-    for (std::size_t a = 0; a < z.extent(1); ++a) z(i, a) = 0.0;
+  // reach them: they are the slow components CG is left with). Z is n × k and sparse: a dof row
+  // holds the 6 columns of each body whose cells reach its node (node_bodies, sorted by node).
+  using row_offsets_type = crs_matrix_type::local_graph_device_type::row_map_type::non_const_type;
+  using columns_type = crs_matrix_type::local_graph_device_type::entries_type::non_const_type;
+  using values_type = crs_matrix_type::local_matrix_device_type::values_type;
+  std::vector<int> bodies_of(owned + 1, 0);  // prefix counts of each owned node's bodies
+  for (const auto& [node, body] : bodies.node_bodies)
+    if (static_cast<std::size_t>(node) < owned) ++bodies_of[node + 1];
+  for (std::size_t i = 0; i < owned; ++i) bodies_of[i + 1] += bodies_of[i];
+  row_offsets_type offsets("viscompm stiff modes offsets", 3 * owned + 1);
+  for (std::size_t i = 0; i < owned; ++i)
+    for (int d = 0; d < 3; ++d) offsets(3 * i + d) = 6 * (3 * bodies_of[i] + d * (bodies_of[i + 1] - bodies_of[i]));
+  offsets(3 * owned) = 18 * static_cast<std::size_t>(bodies_of[owned]);
+  const std::size_t entries = offsets(3 * owned);
+  columns_type columns("viscompm stiff modes columns", entries);
+  values_type values("viscompm stiff modes values", entries);
   const auto& projection = potential.constraints().projection;
+  std::vector<int> filled(owned, 0);  // bodies of a node written so far
   for (const auto& [node, body] : bodies.node_bodies) {
     if (static_cast<std::size_t>(node) >= owned) continue;
     const Vec3 r = partition.geometry().node_position(partition.nodes()[node]) - bodies.centroids[body];
@@ -97,12 +110,26 @@ void NewtonSystem::Impl::build_stiff_modes(const implicit::IncrementalPotential&
     Mat3 rotations;
     rotations << 0.0, r.z(), -r.y(), -r.z(), 0.0, r.x(), r.y(), -r.x(), 0.0;  // column a: e_a × r
     const Mat3 rotation_columns = P * rotations;
-    for (int d = 0; d < 3; ++d)
+    const int slot = filled[node]++;
+    for (int d = 0; d < 3; ++d) {
+      std::size_t at = offsets(3 * node + d) + 6 * slot;
       for (int a = 0; a < 3; ++a) {
-        z(3 * node + d, 6 * body + a) = P(d, a);
-        z(3 * node + d, 6 * body + 3 + a) = rotation_columns(d, a);
+        columns(at + a) = 6 * body + a;
+        values(at + a) = P(d, a);
+        columns(at + 3 + a) = 6 * body + 3 + a;
+        values(at + 3 + a) = rotation_columns(d, a);
       }
+    }
   }
+  // Columns: the k modes, all on every rank (local index = mode); their domain on rank 0.
+  const auto comm = space.impl().owned_dof_map->getComm();
+  Teuchos::Array<global_ordinal_type> all(k);
+  for (int a = 0; a < k; ++a) all[a] = a;
+  const auto column_map = Teuchos::rcp(new map_type(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid(), all(), 0, comm));
+  const auto domain_map = Teuchos::rcp(new map_type(k, comm->getRank() == 0 ? k : 0, 0, comm));
+  stiff_modes = Teuchos::rcp(new crs_matrix_type(space.impl().owned_dof_map, column_map, offsets, columns, values));
+  stiff_modes->expertStaticFillComplete(domain_map, space.impl().owned_dof_map,
+                                        Teuchos::rcp(new import_type(domain_map, column_map)));
 }
 
 void NewtonSystem::Impl::to_owned(const NodeVectorField& field, multivector_type& owned) const {
@@ -163,7 +190,8 @@ double NewtonSystem::precondition() {
   m.preconditioner->setup(*m.hessian, m.preconditioned_for != m.pattern_version, m.modes);
   m.deflated = m.stiff_modes.is_null()
                    ? Teuchos::null
-                   : Teuchos::rcp(new DeflatedPreconditioner(*m.hessian->op(), m.preconditioner->op(), m.stiff_modes));
+                   : Teuchos::rcp(new DeflatedPreconditioner(*m.hessian->op(), m.hessian->matrix(),
+                                                             m.preconditioner->op(), *m.stiff_modes));
   m.preconditioned_for = m.pattern_version;
   return seconds_since(start);
 }

@@ -233,15 +233,40 @@ Teuchos::RCP<crs_matrix_type> make_prolongator(const parallel::CoarseLevel& c, c
   return P;
 }
 
+// While it lives, the entries of A that are exactly zero hold a tiny positive value instead
+// (far below rounding of any real entry), so that a product formed meanwhile keeps them in its
+// pattern; they are zero again afterwards.
+class StructuralZeros {
+ public:
+  explicit StructuralZeros(crs_matrix_type& A) : values_(A.getLocalMatrixDevice().values) {
+    for (std::size_t k = 0; k < values_.extent(0); ++k)
+      if (values_(k) == 0.0) {
+        values_(k) = tiny;
+        filled_.push_back(k);
+      }
+  }
+  ~StructuralZeros() {
+    for (const std::size_t k : filled_) values_(k) = 0.0;
+  }
+  StructuralZeros(const StructuralZeros&) = delete;
+  StructuralZeros& operator=(const StructuralZeros&) = delete;
+
+ private:
+  static constexpr double tiny = 1e-200;
+  crs_matrix_type::local_matrix_device_type::values_type values_;
+  std::vector<std::size_t> filled_;
+};
+
 class MueLuPreconditioner : public Preconditioner {
  public:
   explicit MueLuPreconditioner(const SolverConfiguration& config) : config_(config) {}
-  // New values on the same pattern refresh what depends on values and keep what does not:
-  // geometric prolongators are kept and everything else is built anew (Galerkin products,
-  // smoothers with fresh Chebyshev bounds, the coarse solve); an algebraic hierarchy whose file asks
-  // for MueLu's reuse is reused by MueLu, its Chebyshev bounds re-estimated (MueLu 13.2 keeps the
-  // first matrix's), or built anew when MueLu cannot reuse it (it throws when what it kept no
-  // longer fits). The fine level's grid-line blocks get a fresh damping either way.
+  // New values on the same pattern refresh what depends on values and keep what does not: a
+  // geometric hierarchy keeps its prolongators and the patterns of its Galerkin products (MueLu's
+  // "RP" reuse: only their values are recomputed) and rebuilds the smoothers and the coarse
+  // solve; an algebraic hierarchy whose file asks for MueLu's reuse is reused the same way. Either
+  // gets its Chebyshev bounds re-estimated (MueLu 13.2 keeps the first matrix's), and is built
+  // anew when MueLu cannot reuse it (it throws when what it kept no longer fits). The fine level's
+  // grid-line blocks get a fresh damping either way.
   void setup(const HessianOperator& H, bool pattern_changed, const NearNullspace& modes) override {
     const Teuchos::RCP<crs_matrix_type> A = H.matrix();
     const SolverSettings& settings = config_.impl().settings;
@@ -250,11 +275,14 @@ class MueLuPreconditioner : public Preconditioner {
       geometric_levels_.clear();
       lines_.clear();
     }
-    if (!pattern_changed && !prec_.is_null() && settings.prolongation == Prolongation::algebraic && settings.muelu_reuse) {
+    // A geometric hierarchy is always reused on the same pattern: its P is fixed, so MueLu only
+    // refills the values of the Galerkin products it kept (no symbolic product, no allocation).
+    const bool reuse = settings.prolongation == Prolongation::algebraic ? settings.muelu_reuse : true;
+    if (!pattern_changed && !prec_.is_null() && reuse) {
       try {
         const SilencedStdout quiet;
         MueLu::ReuseTpetraPreconditioner(A, *prec_);
-        refresh_chebyshev_bounds();
+        refresh_reused_smoothers();
         finish_setup(H, *A, pattern_changed, modes);
         return;
       } catch (const std::exception&) {
@@ -367,7 +395,9 @@ class MueLuPreconditioner : public Preconditioner {
         level.sublist("smoother: params") = lines_[l + 1].list();
       }
     }
-    params.remove("reuse: type", false);  // what reuse can keep (the P) is kept above
+    // The P are the user's (kept above, per pattern); MueLu keeps the patterns of A·P and Pᵀ·A·P
+    // and refills their values when the next set-up on the same pattern reuses the hierarchy.
+    params.set("reuse: type", std::string("RP"));
     params.set("max levels", static_cast<int>(geometric_levels_.size()) + 1);
     params.set("coarse: max size", 1);
     Teuchos::ParameterList serializable, non_serializable;
@@ -377,7 +407,14 @@ class MueLuPreconditioner : public Preconditioner {
     hierarchy->setlib(Xpetra::UseTpetra);
     muelu_hierarchy_utils_type::AddNonSerializableDataToHierarchy(interpreter, *hierarchy, non_serializable);
     hierarchy->GetLevel(0)->Set("A", MueLu::TpetraCrs_To_XpetraMatrix(A));
-    interpreter.SetupHierarchy(*hierarchy);
+    {
+      // Tpetra's product leaves out the entries of A that are zero now (node pairs no particle
+      // couples yet), and reusing a product whose pattern misses entries that are nonzero later
+      // throws. Built with every entry of A's graph present, the kept patterns cover any later
+      // values on this graph.
+      const StructuralZeros filled(*A);
+      interpreter.SetupHierarchy(*hierarchy);
+    }
     prec_ = Teuchos::rcp(new muelu_operator_type(hierarchy));
   }
 
@@ -397,18 +434,26 @@ class MueLuPreconditioner : public Preconditioner {
     return smoothers;
   }
 
-  // MueLu 13.2 hands a reused Chebyshev smoother the largest eigenvalue it estimated for the first
-  // matrix (cached in the smoother's list): without it, Ifpack2 estimates it for the current one.
-  void refresh_chebyshev_bounds() {
+  // MueLu 13.2 reuses a level's Ifpack2 smoothers and coarse solver on new values with compute()
+  // alone, which keeps what their initialize() copied from the old matrix: the overlapping rows
+  // of an additive Schwarz coarse solve, the block containers of a block relaxation. And it hands
+  // a reused Chebyshev smoother the largest eigenvalue it estimated for the first matrix (cached
+  // in the smoother's list). Each is initialised and computed again on its level's new matrix,
+  // Chebyshev without the cached bound, so that Ifpack2 estimates it for the current one.
+  void refresh_reused_smoothers() {
     for (int l = 0; l < prec_->GetHierarchy()->GetNumLevels(); ++l)
       for (const auto& smoother : level_smoothers(l)) {
-        auto chebyshev = Teuchos::rcp_dynamic_cast<Ifpack2::Chebyshev<row_matrix_type>>(smoother->getPreconditioner());
-        if (chebyshev.is_null()) continue;
-        Teuchos::ParameterList& list = const_cast<Teuchos::ParameterList&>(smoother->GetParameterList());
-        list.remove("chebyshev: max eigenvalue", false);
-        Teuchos::ParameterList fresh = list;
-        chebyshev->setParameters(fresh);
-        chebyshev->compute();
+        const auto preconditioner = smoother->getPreconditioner();
+        if (preconditioner.is_null()) continue;
+        if (auto chebyshev = Teuchos::rcp_dynamic_cast<Ifpack2::Chebyshev<row_matrix_type>>(preconditioner);
+            !chebyshev.is_null()) {
+          Teuchos::ParameterList& list = const_cast<Teuchos::ParameterList&>(smoother->GetParameterList());
+          list.remove("chebyshev: max eigenvalue", false);
+          Teuchos::ParameterList fresh = list;
+          chebyshev->setParameters(fresh);
+        }
+        preconditioner->initialize();
+        preconditioner->compute();
       }
   }
 
