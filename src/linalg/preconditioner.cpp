@@ -274,6 +274,7 @@ class MueLuPreconditioner : public Preconditioner {
     if (pattern_changed) {
       geometric_levels_.clear();
       lines_.clear();
+      whole_graph_ = false;
     }
     // A geometric hierarchy is always reused on the same pattern: its P is fixed, so MueLu only
     // refills the values of the Galerkin products it kept (no symbolic product, no allocation).
@@ -286,7 +287,8 @@ class MueLuPreconditioner : public Preconditioner {
         finish_setup(H, *A, pattern_changed, modes);
         return;
       } catch (const std::exception&) {
-        prec_ = Teuchos::null;  // built anew below
+        prec_ = Teuchos::null;  // built anew below, on the whole graph of A
+        whole_graph_ = true;
       }
     }
     Teuchos::ParameterList params = *config_.impl().preconditioner_parameters;
@@ -407,12 +409,15 @@ class MueLuPreconditioner : public Preconditioner {
     hierarchy->setlib(Xpetra::UseTpetra);
     muelu_hierarchy_utils_type::AddNonSerializableDataToHierarchy(interpreter, *hierarchy, non_serializable);
     hierarchy->GetLevel(0)->Set("A", MueLu::TpetraCrs_To_XpetraMatrix(A));
-    {
+    if (whole_graph_) {
       // Tpetra's product leaves out the entries of A that are zero now (node pairs no particle
       // couples yet), and reusing a product whose pattern misses entries that are nonzero later
-      // throws. Built with every entry of A's graph present, the kept patterns cover any later
-      // values on this graph.
+      // throws. Once that happened on this pattern, the hierarchy is built with every entry of A's
+      // graph present, so that the kept patterns cover any later values on it (at some cost: the
+      // coarse levels then hold the couplings of the graph's padding too).
       const StructuralZeros filled(*A);
+      interpreter.SetupHierarchy(*hierarchy);
+    } else {
       interpreter.SetupHierarchy(*hierarchy);
     }
     prec_ = Teuchos::rcp(new muelu_operator_type(hierarchy));
@@ -490,6 +495,7 @@ class MueLuPreconditioner : public Preconditioner {
   SolverConfiguration config_;
   Teuchos::RCP<muelu_operator_type> prec_;
   std::vector<Teuchos::RCP<xpetra_matrix_type>> geometric_levels_;  // P of levels 1, 2, ... (this pattern)
+  bool whole_graph_ = false;  // this pattern's hierarchy is built on every entry of A's graph
   std::vector<GridLines> lines_;  // per level that smooths on grid lines, finest first
   std::shared_ptr<LineSmoother> lean_lines_;  // Cycle = lean: the fine level's smoother
   Teuchos::RCP<LeanCycle> lean_;              // Cycle = lean: the preconditioner
