@@ -1,6 +1,5 @@
 #include "line_smoother.hpp"
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <stdexcept>
 
@@ -13,32 +12,9 @@ void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, con
 
 namespace viscompm::linalg {
 
-void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_A, double line_damping) {
-  const auto& rows = *A.getRowMap();
-  const auto& columns = *A.getColMap();
+template <class Visit>
+void LineSmoother::for_each_line_entry(const crs_matrix_type& A, Visit&& visit) {
   const std::size_t n = A.getNodeNumRows();
-  // Local column → local row (−1 for a ghost column).
-  std::vector<int> column_row(columns.getNodeNumElements());
-  for (std::size_t c = 0; c < column_row.size(); ++c)
-    column_row[c] = rows.getLocalElement(columns.getGlobalElement(static_cast<local_ordinal_type>(c)));
-  // Each node's position on its line of each axis (lines come axis by axis, one per node each).
-  const std::size_t nodes = n / 3;
-  std::vector<int> line_of(3 * nodes, -1), position_of(3 * nodes, -1);
-  std::vector<int> axis_of_line(lines_.size());
-  {
-    std::vector<int> seen(nodes, 0);
-    for (std::size_t l = 0; l < lines_.size(); ++l)
-      for (std::size_t k = 0; k < lines_[l].size(); ++k) {
-        const std::size_t node = lines_[l][k];
-        const int axis = seen[node]++;
-        if (axis > 2) throw std::logic_error("LineSmoother: a node on more than three lines");
-        if (k == 0) axis_of_line[l] = axis;
-        line_of[3 * node + axis] = static_cast<int>(l);
-        position_of[3 * node + axis] = static_cast<int>(k);
-      }
-  }
-  std::vector<Eigen::MatrixXd> blocks(lines_.size());
-  for (std::size_t l = 0; l < lines_.size(); ++l) blocks[l] = Eigen::MatrixXd::Zero(3 * lines_[l].size(), 3 * lines_[l].size());
   for (std::size_t r = 0; r < n; ++r) {
     crs_matrix_type::local_inds_host_view_type cols;
     crs_matrix_type::values_host_view_type vals;
@@ -46,42 +22,76 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
     const std::size_t node = r / 3;
     const int sigma = static_cast<int>(r % 3);
     for (int axis = 0; axis < 3; ++axis) {
-      const int l = line_of[3 * node + axis];
+      const int l = line_of_[3 * node + axis];
       if (l < 0) continue;
-      const int i = position_of[3 * node + axis];
+      const int i = 3 * position_of_[3 * node + axis] + sigma;
       for (std::size_t k = 0; k < cols.extent(0); ++k) {
-        const int row = column_row[cols(k)];
+        const int row = column_row_[cols(k)];
         if (row < 0) continue;
         const std::size_t other = static_cast<std::size_t>(row) / 3;
-        if (line_of[3 * other + axis] != l) continue;
-        blocks[l](3 * i + sigma, 3 * position_of[3 * other + axis] + row % 3) = vals(k);
+        if (line_of_[3 * other + axis] != l) continue;
+        const int j = 3 * position_of_[3 * other + axis] + row % 3;
+        if (i >= j) visit(factors_[l], i, j, vals(k));
       }
     }
   }
-  factors_.resize(lines_.size());
-  for (std::size_t l = 0; l < lines_.size(); ++l) {
-    const Eigen::MatrixXd& block = blocks[l];
-    BandFactor& f = factors_[l];
-    f.rows = static_cast<int>(block.rows());
-    f.bandwidth = 0;
-    for (int j = 0; j < f.rows; ++j)
-      for (int i = f.rows - 1; i > j + f.bandwidth; --i)
-        if (block(i, j) != 0.0) f.bandwidth = i - j;
+}
+
+void LineSmoother::index_lines(const crs_matrix_type& A) {
+  const auto& rows = *A.getRowMap();
+  const auto& columns = *A.getColMap();
+  const std::size_t n = A.getNodeNumRows();
+  // Local column → local row (−1 for a ghost column).
+  column_row_.assign(columns.getNodeNumElements(), -1);
+  for (std::size_t c = 0; c < column_row_.size(); ++c)
+    column_row_[c] = rows.getLocalElement(columns.getGlobalElement(static_cast<local_ordinal_type>(c)));
+  // Each node's position on its line of each axis (lines come axis by axis, one per node each).
+  const std::size_t nodes = n / 3;
+  line_of_.assign(3 * nodes, -1);
+  position_of_.assign(3 * nodes, -1);
+  {
+    std::vector<int> seen(nodes, 0);
+    for (std::size_t l = 0; l < lines_.size(); ++l)
+      for (std::size_t k = 0; k < lines_[l].size(); ++k) {
+        const std::size_t node = lines_[l][k];
+        const int axis = seen[node]++;
+        if (axis > 2) throw std::logic_error("LineSmoother: a node on more than three lines");
+        line_of_[3 * node + axis] = static_cast<int>(l);
+        position_of_[3 * node + axis] = static_cast<int>(k);
+      }
+  }
+  // Each line's band: the farthest entry of A's graph below the diagonal of its block.
+  factors_.assign(lines_.size(), BandFactor{});
+  for (std::size_t l = 0; l < lines_.size(); ++l) factors_[l].rows = static_cast<int>(3 * lines_[l].size());
+  for_each_line_entry(A, [&](BandFactor& f, int i, int j, double) { f.graph_bandwidth = std::max(f.graph_bandwidth, i - j); });
+  indexed_graph_ = A.getCrsGraph().get();
+}
+
+void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_A, double line_damping) {
+  if (indexed_graph_ != A.getCrsGraph().get()) index_lines(A);
+  for (BandFactor& f : factors_) {
+    f.bandwidth = f.graph_bandwidth;
+    f.band.assign(static_cast<std::size_t>(f.bandwidth + 1) * f.rows, 0.0);
+  }
+  // The lower band of each line's block, column-major: entry (i, j), i ≥ j, at j (bandwidth + 1) + i − j.
+  for_each_line_entry(A, [](BandFactor& f, int i, int j, double value) { f.band[j * (f.bandwidth + 1) + (i - j)] = value; });
+  std::vector<double> diagonal;
+  for (BandFactor& f : factors_) {
     const int ld = f.bandwidth + 1;
-    f.band.assign(static_cast<std::size_t>(ld) * f.rows, 0.0);
-    for (int j = 0; j < f.rows; ++j)
-      for (int i = j; i <= std::min(f.rows - 1, j + f.bandwidth); ++i) f.band[j * ld + (i - j)] = block(i, j);
+    diagonal.resize(f.rows);
+    for (int j = 0; j < f.rows; ++j) diagonal[j] = f.band[static_cast<std::size_t>(j) * ld];
     int info = 0;
     dpbtrf_("L", &f.rows, &f.bandwidth, f.band.data(), &ld, &info);
     if (info != 0) {
       // No Cholesky factor: H assembled unprojected (Newton's first attempt under adaptive
       // projection) is indefinite on this line. The smoother must stay SPD for CG, so the line is
       // smoothed by |diag H| (Jacobi); whether CG can use H itself is Newton's to find out.
-      const double largest = block.diagonal().cwiseAbs().maxCoeff();
+      double largest = 0.0;
+      for (const double d : diagonal) largest = std::max(largest, std::abs(d));
       f.bandwidth = 0;
       f.band.resize(static_cast<std::size_t>(f.rows));
       for (int j = 0; j < f.rows; ++j) {
-        const double d = std::abs(block(j, j));
+        const double d = std::abs(diagonal[j]);
         f.band[j] = std::sqrt(d > 1e-12 * largest ? d : (largest > 0.0 ? largest : 1.0));
       }
     }

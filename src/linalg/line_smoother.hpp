@@ -42,10 +42,21 @@ class LineSmoother {
   /// A line's block factored by dpbtrf, lower band storage: (bandwidth + 1) × rows, column-major.
   struct BandFactor {
     int rows = 0, bandwidth = 0;
+    int graph_bandwidth = 0;  // of the line's block in A's graph (a line smoothed by |diag| has 0)
     std::vector<double> band;
   };
+  /// Where each row and column of A lies on the lines, and each line's band, from A's graph
+  /// (once per graph: the values change, the graph does not).
+  void index_lines(const crs_matrix_type& A);
+  /// visit(line's factor, i, j, value) for every entry of A in a line's block on or below its
+  /// diagonal (i ≥ j, positions in the block).
+  template <class Visit>
+  void for_each_line_entry(const crs_matrix_type& A, Visit&& visit);
   std::vector<std::vector<std::size_t>> lines_;
   std::vector<BandFactor> factors_;
+  const crs_graph_type* indexed_graph_ = nullptr;  // the graph the indices below are for
+  std::vector<int> column_row_;                     // local column → local row (−1: ghost)
+  std::vector<int> line_of_, position_of_;          // per node and axis: its line, its place on it
   double damping_ = 1.0;
   Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate
 };
