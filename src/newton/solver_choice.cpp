@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace viscompm::newton {
@@ -63,8 +64,12 @@ void SolverChoice::step_ended() {
   const double factor = std::max(settings_.regime_change, margin_);
   const bool regime_changed = since_trial_ >= settings_.regime_steps &&
                               (recent_ > factor * reference_ || recent_ * factor < reference_);
-  if (regime_changed) interval_ = settings_.recheck_steps;
-  if (regime_changed || since_trial_ >= interval_) start_trial();
+  // One step beyond the regime factor that also cost more than the closest loser's trial step
+  // cannot wait for the running mean: the loser may already be the cheaper (the pie's crust
+  // reaching the head while the paper's solver is chosen).
+  const bool jumped = cost > settings_.regime_change * reference_ && cost > loser_cost_;
+  if (regime_changed || jumped) interval_ = settings_.recheck_steps;
+  if (regime_changed || jumped || since_trial_ >= interval_) start_trial();
 }
 
 void SolverChoice::start_trial() {
@@ -89,6 +94,9 @@ void SolverChoice::next_trial_candidate() {
   // The margin: how many times the winner's cost the closest loser's step cost (at least; a
   // stopped one's is a lower bound).
   margin_ = 0.0;
+  loser_cost_ = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < candidates_; ++c)
+    if (c != best) loser_cost_ = std::min(loser_cost_, trial_cost_[c]);
   for (int c = 0; c < candidates_; ++c)
     if (c != best && trial_cost_[best] > 0.0)
       margin_ = margin_ == 0.0 ? trial_cost_[c] / trial_cost_[best] : std::min(margin_, trial_cost_[c] / trial_cost_[best]);

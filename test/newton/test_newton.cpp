@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <string>
 
 #include "gather.hpp"
 #include "scenes.hpp"
@@ -83,14 +84,17 @@ class FailingSystem : public newton::LinearSystem {
   double assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
     ++assemblies;
     projected_assemblies += project;
+    calls += 'A';
     return real_->assemble(potential, v, project);
   }
   double precondition() override {
     ++setups;
+    calls += 'P';
     return real_->precondition();
   }
   linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) override {
     ++solves;
+    calls += 'S';
     if (!failing) return real_->solve(rhs, dv, tolerance);
     dv.resize(rhs.size());
     for (std::size_t i = 0; i < rhs.size(); ++i) dv[i] = -rhs[i];  // +∇E: uphill
@@ -109,6 +113,7 @@ class FailingSystem : public newton::LinearSystem {
 
   bool failing = true;
   int assemblies = 0, projected_assemblies = 0, setups = 0, solves = 0;
+  std::string calls;  // in order: A assembly, P preconditioner set-up, S solve
 
  private:
   std::unique_ptr<newton::LinearSystem> real_;
@@ -142,16 +147,22 @@ TEST_F(NewtonOnASpinningBlock, WhenEverySolveFailsEachDirectionEndsAfterAtMostTh
     failing.failing = false;
     NodeVectorField v_converged = v;
     ASSERT_TRUE(keeping.solve(*objective->potential, v_converged).converged) << update;
+    // Whether the kept preconditioner was set up from the kept H: a lagged H re-assembled within
+    // the converged step (a shortened line-search step, a slow contraction: rounding decides) is
+    // preconditioned again at the next step's first attempt under "every step", not under "lagged".
+    const bool preconditioner_matches = failing.calls.find_last_of('A') < failing.calls.find_last_of('P');
+    const std::string kept_attempt = std::string(update) == "every step" && !preconditioner_matches ? "PS" : "S";
     failing.failing = true;
     failing.solves = failing.assemblies = failing.projected_assemblies = failing.setups = 0;
+    failing.calls.clear();
     NodeVectorField v_kept = v;
     const auto second = keeping.solve(*objective->potential, v_kept);
     EXPECT_FALSE(second.converged) << update;
     EXPECT_EQ(second.iterations, 1) << update;
     EXPECT_EQ(failing.solves, newton::NewtonSolver::direction_attempts) << update;
-    EXPECT_EQ(failing.assemblies, 2) << update;
     EXPECT_EQ(failing.projected_assemblies, 1) << update;
-    EXPECT_EQ(failing.setups, 2) << update;
+    // The kept H (no assembly), then a fresh exact and a fresh projected H, each preconditioned.
+    EXPECT_EQ(failing.calls, kept_attempt + "APS" + "APS") << update;
   }
 }
 

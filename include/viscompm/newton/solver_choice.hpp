@@ -13,7 +13,8 @@
 // (their excess over the winner at most `Trial overhead` of the winner's steps in between); or
 // at once when the chosen one's cost per step moves by more than the factor `Regime change`, or
 // the margin the loser lost by if larger, from what it cost when last confirmed (a soft body met
-// a stiff one). A trial that finds a cheaper candidate switches to it.
+// a stiff one), or when a single step of it costs `Regime change` times that and more than the
+// closest loser's trial step. A trial that finds a cheaper candidate switches to it.
 #pragma once
 
 #include <cstddef>
@@ -65,6 +66,7 @@ class SolverChoice {
   double reference_ = 0.0;             ///< the chosen one's cost per step when last confirmed
   double recent_ = 0.0;                ///< its recent cost per step (a running mean)
   double margin_ = 1.0;                ///< the closest loser's cost over the winner's, last trial
+  double loser_cost_ = 0.0;            ///< the closest loser's step cost, last trial (a lower bound if stopped)
   int since_trial_ = 0;                ///< steps of the chosen one since the last trial
   int interval_ = 0;                   ///< steps until the next trial
   int trials_ = 0;
