@@ -215,7 +215,8 @@ struct ChoiceFile {
           .integer(&C::max_recheck_steps, "Max recheck steps", 256, Range::closed(1, 1000000),
                    "the interval between trials doubles, each time a trial confirms the choice, up to this")
           .real(&C::regime_change, "Regime change", 2.0, Range::open_closed(1.0, 1e6),
-                "a trial at once when the chosen one's recent seconds per step move by this factor from its trial's")
+                "a trial at once when the chosen one's recent seconds per step move by this factor from its trial's, "
+                "or one step does and costs more than the closest loser's trial step")
           .integer(&C::regime_steps, "Regime steps", 4, Range::closed(1, 1000000),
                    "steps after a trial before a regime change is looked for")
           .real(&C::trial_overhead, "Trial overhead", 0.05, Range::open_closed(0.0, 1.0),

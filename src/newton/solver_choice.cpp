@@ -64,10 +64,11 @@ void SolverChoice::step_ended() {
   const double factor = std::max(settings_.regime_change, margin_);
   const bool regime_changed = since_trial_ >= settings_.regime_steps &&
                               (recent_ > factor * reference_ || recent_ * factor < reference_);
-  // One step beyond the regime factor that also cost more than the closest loser's trial step
-  // cannot wait for the running mean: the loser may already be the cheaper (the pie's crust
-  // reaching the head while the paper's solver is chosen).
-  const bool jumped = cost > settings_.regime_change * reference_ && cost > loser_cost_;
+  // One step that cost the regime factor times both its reference and the closest loser's trial
+  // step cannot wait for the running mean: the loser may already be the cheaper (the pie's crust
+  // reaching the head while the paper's solver is chosen). A step only dearer than its reference
+  // (a hierarchy built anew) is left to the mean.
+  const bool jumped = cost > settings_.regime_change * std::max(reference_, loser_cost_);
   if (regime_changed || jumped) interval_ = settings_.recheck_steps;
   if (regime_changed || jumped || since_trial_ >= interval_) start_trial();
 }

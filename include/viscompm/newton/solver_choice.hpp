@@ -13,7 +13,7 @@
 // (their excess over the winner at most `Trial overhead` of the winner's steps in between); or
 // at once when the chosen one's cost per step moves by more than the factor `Regime change`, or
 // the margin the loser lost by if larger, from what it cost when last confirmed (a soft body met
-// a stiff one), or when a single step of it costs `Regime change` times that and more than the
+// a stiff one), or when a single step of it costs `Regime change` times both that and the
 // closest loser's trial step. A trial that finds a cheaper candidate switches to it.
 #pragma once
 
