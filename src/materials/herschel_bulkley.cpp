@@ -85,7 +85,7 @@ bool HerschelBulkley::evaluate(const particles::ParticleSet& particles, std::siz
   // "The analogous strain density from Chapter 5" (§4.6.2): (5.8) of (J/J_HB)^{2/3} b_HB, plus (5.11).
   const oldroyd_b::Coefficients c{parameters_.shear_modulus, parameters_.lame_lambda,
                                   viscous_coefficient(convention_, parameters_.newtonian_viscosity, step.dt),
-                                  F_n.determinant()};
+                                  F_n.determinant(), parameters_.viscous_strain};
   return oldroyd_b::evaluate_potential(c, F_n, flow_strain_map(particles, p, step.dt), A, step.dt,
                                        particles.volume0[p], order, out);
 }

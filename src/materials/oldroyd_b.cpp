@@ -37,6 +37,11 @@ double trace_term(double mu, double J, const Mat3& S) {
 }
 }  // namespace
 
+Mat3 viscous_strain(const Coefficients& c, const Mat3& eps) {
+  if (c.viscous_strain == ViscousStrain::full) return eps;
+  return eps - eps.trace() / 3.0 * Mat3::Identity();
+}
+
 bool feasible(const Mat3& F, const Mat3& S) {
   return F.determinant() > 0.0 && S.determinant() > 0.0 && S.trace() > 0.0;
 }
@@ -45,7 +50,7 @@ double energy_density(const Coefficients& c, const Mat3& F, const Mat3& S, const
   const double J = F.determinant();
   const double e = trace_term(c.mu, J, S);
   return e - 1.5 * c.mu - c.mu * std::log(J) + 0.5 * c.lambda * (J - 1.0) * (J - 1.0) +
-         c.viscous * c.J_n * eps.squaredNorm();
+         c.viscous * c.J_n * viscous_strain(c, eps).squaredNorm();
 }
 
 EnergyGradient energy_gradient_blocks(const Coefficients& c, const Mat3& F, const Mat3& S, const Mat3& eps) {
@@ -54,7 +59,7 @@ EnergyGradient energy_gradient_blocks(const Coefficients& c, const Mat3& F, cons
   EnergyGradient g;
   g.F = (2.0 / 3.0 * e - c.mu + c.lambda * (J - 1.0) * J) * F.inverse().transpose();
   g.S = e * (-S.inverse().transpose() / 3.0 + Mat3::Identity() / S.trace());
-  g.eps = 2.0 * c.viscous * c.J_n * eps;
+  g.eps = 2.0 * c.viscous * c.J_n * viscous_strain(c, eps);  // dev is a projector: ∂(d:d)/∂ε = 2d
   return g;
 }
 
@@ -78,8 +83,10 @@ EnergyHessian energy_hessian_blocks(const Coefficients& c, const Mat3& F, const 
   // ∂²/∂F∂S and ∂²/∂S² of the trace term: e (∇ln e ∇ln eᵀ + ∇² ln e).
   h.FS = e * 2.0 / 3.0 * a * dlog_e_dS.transpose();
   h.SS = e * (dlog_e_dS * dlog_e_dS.transpose() + Q_S / 3.0 - iota * iota.transpose() / (T * T));
-  // ∂²/∂ε² of the viscous term.
-  h.eps_eps = 2.0 * c.viscous * c.J_n;
+  // ∂²/∂ε² of the viscous term: 2 c_N J^n times the projector ε ↦ ε (full) or ε ↦ dev ε.
+  h.eps_eps = 2.0 * c.viscous * c.J_n * Mat9::Identity();
+  if (c.viscous_strain == ViscousStrain::deviatoric)
+    h.eps_eps -= 2.0 * c.viscous * c.J_n / 3.0 * iota * iota.transpose();
   return h;
 }
 
@@ -97,7 +104,7 @@ Mat27 energy_hessian(const Coefficients& c, const Mat3& F, const Mat3& S, const 
   m.block<9, 9>(0, 9) = h.FS;
   m.block<9, 9>(9, 0) = h.FS.transpose();
   m.block<9, 9>(9, 9) = h.SS;
-  m.block<9, 9>(18, 18) = h.eps_eps * Mat9::Identity();
+  m.block<9, 9>(18, 18) = h.eps_eps;
   return m;
 }
 
@@ -129,7 +136,7 @@ bool evaluate_potential(const Coefficients& c, const Mat3& F_n, const FlowStrain
   const Mat9 cross = chain.sandwich(Strain::F, h.FS, Strain::S);
   out.hessian = volume * (chain.sandwich(Strain::F, h.FF, Strain::F) + cross + cross.transpose() +
                           chain.sandwich(Strain::S, h.SS, Strain::S) +
-                          h.eps_eps * chain.sandwich(Strain::eps, Mat9::Identity(), Strain::eps));
+                          chain.sandwich(Strain::eps, h.eps_eps, Strain::eps));
   if (map.quadratic) out.hessian += volume * kronecker(map.K2, g.S + g.S.transpose());
   return true;
 }
@@ -176,7 +183,7 @@ bool OldroydB::evaluate(const particles::ParticleSet& particles, std::size_t p, 
     if (!(f_hat.determinant() > 0.0)) return false;
   }
   const oldroyd_b::Coefficients c{parameters_.shear_modulus, parameters_.lame_lambda,
-                                  viscous_coefficient(step.dt), F_n.determinant()};
+                                  viscous_coefficient(step.dt), F_n.determinant(), parameters_.viscous_strain};
   return oldroyd_b::evaluate_potential(c, F_n, flow_strain_map(particles, p, step.dt), A, step.dt,
                                        particles.volume0[p], order, out);
 }

@@ -36,6 +36,8 @@ State unpack(const Vec27& y) {
 }
 
 const oldroyd_b::Coefficients coefficients{360.0, 1400.0, 0.7, 1.3};
+// The same with (5.11) on dev ε̂ only ("Viscous strain" deviatoric).
+const oldroyd_b::Coefficients deviatoric_coefficients{360.0, 1400.0, 0.7, 1.3, ViscousStrain::deviatoric};
 }  // namespace
 
 TEST(OldroydBEnergy, VanishesWithZeroStressAtRest) {
@@ -45,38 +47,42 @@ TEST(OldroydBEnergy, VanishesWithZeroStressAtRest) {
 }
 
 TEST(OldroydBEnergy, GradientMatchesFiniteDifferences) {
-  for (int trial = 0; trial < 50; ++trial) {
-    const State s = random_state();
-    const Vec27 y = pack(s);
-    const Vec27 g = oldroyd_b::energy_gradient(coefficients, s.F, s.S, s.eps);
-    const double h = 1e-6;
-    for (int k = 0; k < 27; ++k) {
-      Vec27 plus = y, minus = y;
-      plus[k] += h;
-      minus[k] -= h;
-      const State a = unpack(plus), b = unpack(minus);
-      const double fd = (oldroyd_b::energy_density(coefficients, a.F, a.S, a.eps) -
-                         oldroyd_b::energy_density(coefficients, b.F, b.S, b.eps)) / (2 * h);
-      EXPECT_NEAR(g[k], fd, 1e-6 * (1.0 + std::abs(fd))) << "trial " << trial << " entry " << k;
+  for (const oldroyd_b::Coefficients& c : {coefficients, deviatoric_coefficients}) {
+    for (int trial = 0; trial < 50; ++trial) {
+      const State s = random_state();
+      const Vec27 y = pack(s);
+      const Vec27 g = oldroyd_b::energy_gradient(c, s.F, s.S, s.eps);
+      const double h = 1e-6;
+      for (int k = 0; k < 27; ++k) {
+        Vec27 plus = y, minus = y;
+        plus[k] += h;
+        minus[k] -= h;
+        const State a = unpack(plus), b = unpack(minus);
+        const double fd = (oldroyd_b::energy_density(c, a.F, a.S, a.eps) -
+                           oldroyd_b::energy_density(c, b.F, b.S, b.eps)) / (2 * h);
+        EXPECT_NEAR(g[k], fd, 1e-6 * (1.0 + std::abs(fd))) << "trial " << trial << " entry " << k;
+      }
     }
   }
 }
 
 TEST(OldroydBEnergy, HessianMatchesFiniteDifferencesOfGradient) {
-  for (int trial = 0; trial < 50; ++trial) {
-    const State s = random_state();
-    const Vec27 y = pack(s);
-    const Mat27 H = oldroyd_b::energy_hessian(coefficients, s.F, s.S, s.eps);
-    EXPECT_LT((H - H.transpose()).norm(), 1e-9 * H.norm());
-    const double h = 1e-6;
-    for (int k = 0; k < 27; ++k) {
-      Vec27 plus = y, minus = y;
-      plus[k] += h;
-      minus[k] -= h;
-      const State a = unpack(plus), b = unpack(minus);
-      const Vec27 fd = (oldroyd_b::energy_gradient(coefficients, a.F, a.S, a.eps) -
-                        oldroyd_b::energy_gradient(coefficients, b.F, b.S, b.eps)) / (2 * h);
-      EXPECT_LT((H.col(k) - fd).norm(), 1e-6 * (1.0 + fd.norm())) << "trial " << trial << " column " << k;
+  for (const oldroyd_b::Coefficients& c : {coefficients, deviatoric_coefficients}) {
+    for (int trial = 0; trial < 50; ++trial) {
+      const State s = random_state();
+      const Vec27 y = pack(s);
+      const Mat27 H = oldroyd_b::energy_hessian(c, s.F, s.S, s.eps);
+      EXPECT_LT((H - H.transpose()).norm(), 1e-9 * H.norm());
+      const double h = 1e-6;
+      for (int k = 0; k < 27; ++k) {
+        Vec27 plus = y, minus = y;
+        plus[k] += h;
+        minus[k] -= h;
+        const State a = unpack(plus), b = unpack(minus);
+        const Vec27 fd = (oldroyd_b::energy_gradient(c, a.F, a.S, a.eps) -
+                          oldroyd_b::energy_gradient(c, b.F, b.S, b.eps)) / (2 * h);
+        EXPECT_LT((H.col(k) - fd).norm(), 1e-6 * (1.0 + fd.norm())) << "trial " << trial << " column " << k;
+      }
     }
   }
 }
@@ -169,4 +175,112 @@ TEST(ViscosityConvention, PaperAndPhysicalCoefficients) {
   EXPECT_DOUBLE_EQ(OldroydB("a", p).viscous_coefficient(0.01), 2.5);  // Φ^N = μ^N ε̂:ε̂ V^n (5.11)
   p.viscosity_convention = ViscosityConvention::physical;
   EXPECT_DOUBLE_EQ(OldroydB("b", p).viscous_coefficient(0.01), 0.025);  // Φ^N = Δt η ε̂:ε̂ V^n
+}
+
+namespace {
+// Table 5.2's toothpaste (ρ 1, μ 0.839, λ 8.39, μ^N 0.1 in the paper convention) as `model`
+// (oldroyd_b or herschel_bulkley), with (5.11) on `viscous_strain` and μ^N = `viscosity`.
+std::unique_ptr<Material> paste(const std::string& model, const std::string& viscous_strain, double viscosity = 0.1) {
+  std::vector<std::pair<std::string, ParameterValue>> values = {
+      {"Density", 1.0},
+      {"Shear modulus", 0.839},
+      {"Lame lambda", 8.39},
+      {"Newtonian viscosity", viscosity},
+      {"Viscosity convention", std::string("paper")},
+      {"Viscous strain", viscous_strain}};
+  if (model == "oldroyd_b") values.push_back({"Weissenberg number", 0.4});
+  return testkit::build_material({model + "_" + viscous_strain, model, values}, "paste");
+}
+
+// A particle at rest in shape (b = I) but compressed to J^n = 0.8, as the paste in the falling rope.
+particles::ParticleSet compressed_particle() {
+  particles::ParticleSet ps;
+  ps.add(0, Vec3::Zero(), Vec3::Zero(), 1.0, 1.0, 0);
+  ps.deformation_gradient[0] = std::cbrt(0.8) * Mat3::Identity();
+  return ps;
+}
+
+// One quasi-static step under a purely volumetric A = αI and no load: the α where ∂Φ/∂A : I = 0
+// (Φ is convex in α here), by Newton on α.
+double unloaded_alpha(const Material& m, const particles::ParticleSet& ps, double dt) {
+  const Vec9 iota = vec(Mat3::Identity());
+  double alpha = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    PotentialDerivatives d;
+    EXPECT_TRUE(m.evaluate(ps, 0, alpha * Mat3::Identity(), {dt}, 2, d));
+    const double g = vec(d.gradient).dot(iota), h = iota.dot(d.hessian * iota);
+    const double step = -g / h;
+    alpha += step;
+    if (std::abs(step) < 1e-14) break;
+  }
+  return alpha;
+}
+}  // namespace
+
+class ViscousStrainOption : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ViscousStrainOption, DeviatoricLeavesAVolumeChangeToTheElasticResponse) {
+  // Asked by the crushed toothpaste (doc/scenes.md): (5.11) on the full ε̂ resists a change of
+  // volume with a bulk viscosity 2c_N/3 (η = μ^N/Δt = 25 Pa s at Δt = 0.004, against a bulk
+  // modulus of 9 Pa); on dev ε̂ it does not, and the volume is the elastic energy's alone.
+  const std::string model = GetParam();
+  const auto full = paste(model, "full"), deviatoric = paste(model, "deviatoric"), inviscid = paste(model, "full", 0.0);
+  const particles::ParticleSet ps = compressed_particle();
+  const double dt = 0.004, J_n = 0.8;
+
+  // A pure volume rate: deviatoric is the inviscid energy; full adds c_N J^n (3 α²/Δt²) V^0.
+  const Mat3 volumetric = 0.01 * Mat3::Identity();
+  PotentialDerivatives f, d, e;
+  ASSERT_TRUE(full->evaluate(ps, 0, volumetric, {dt}, 2, f));
+  ASSERT_TRUE(deviatoric->evaluate(ps, 0, volumetric, {dt}, 2, d));
+  ASSERT_TRUE(inviscid->evaluate(ps, 0, volumetric, {dt}, 2, e));
+  EXPECT_NEAR(d.energy, e.energy, 1e-12 * std::abs(e.energy));
+  EXPECT_LT((d.gradient - e.gradient).norm(), 1e-12 * e.gradient.norm());
+  EXPECT_NEAR(f.energy - e.energy, 0.1 * J_n * 3.0 * std::pow(0.01 / dt, 2), 1e-9 * f.energy);
+  // A pure shear (traceless, symmetric): the two options are the same potential; their Hessians
+  // differ only along the volume rate: by 2 c_N J^n V^0 / (3 Δt²) vec(I) vec(I)ᵀ.
+  Mat3 shear = Mat3::Zero();
+  shear(0, 1) = shear(1, 0) = 0.01;
+  ASSERT_TRUE(full->evaluate(ps, 0, shear, {dt}, 2, f));
+  ASSERT_TRUE(deviatoric->evaluate(ps, 0, shear, {dt}, 2, d));
+  EXPECT_NEAR(d.energy, f.energy, 1e-12 * f.energy);
+  EXPECT_LT((d.gradient - f.gradient).norm(), 1e-12 * f.gradient.norm());
+  const Vec9 iota = vec(Mat3::Identity());
+  const Mat9 volume_rate = 2.0 * 0.1 * J_n / (3.0 * dt * dt) * iota * iota.transpose();
+  EXPECT_LT((f.hessian - d.hessian - volume_rate).norm(), 1e-9 * f.hessian.norm());
+
+  // One unloaded step from J^n = 0.8: deviatoric springs back to the elastic rest volume J = 1 in
+  // one step, exactly as the inviscid paste; full keeps the particle crushed (J < 0.81).
+  const double a_full = unloaded_alpha(*full, ps, dt), a_dev = unloaded_alpha(*deviatoric, ps, dt),
+               a_inviscid = unloaded_alpha(*inviscid, ps, dt);
+  const auto J_after = [&](double a) { return std::pow(1.0 + a, 3) * J_n; };
+  EXPECT_NEAR(J_after(a_dev), 1.0, 1e-10);
+  EXPECT_NEAR(a_dev, a_inviscid, 1e-12);
+  EXPECT_GT(J_after(a_full), J_n);
+  EXPECT_LT(J_after(a_full), 0.81);
+
+  // The flow step (the b update after the solve) never changes the volume in either option: the
+  // elastic strain's det b^E is J² of the stored F (5.5), whatever b_OB or b_HB became.
+  for (const auto* m : {full.get(), deviatoric.get()}) {
+    for (double a : {a_full, a_dev}) {
+      particles::ParticleSet stepped = compressed_particle();
+      m->update_state(stepped, 0, a * Mat3::Identity(), {dt});
+      const double J = stepped.deformation_gradient[0].determinant();
+      EXPECT_NEAR(J, J_after(a), 1e-12);
+      EXPECT_NEAR(m->left_cauchy_green_elastic(stepped, 0).determinant(), J * J, 1e-12);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, ViscousStrainOption, ::testing::Values("oldroyd_b", "herschel_bulkley"));
+
+TEST(ViscousStrainOption, DefaultIsTheThesisAndTheChoicesAreFullAndDeviatoric) {
+  // (A value outside the choices fails on read: test_scene, EveryModelValidatesItsParameters...)
+  EXPECT_EQ(OldroydBParameters{}.viscous_strain, ViscousStrain::full);
+  EXPECT_EQ(testkit::parsed_parameters<OldroydBParameters>({}).viscous_strain, ViscousStrain::full);
+  const auto deviatoric =
+      testkit::parsed_parameters<OldroydBParameters>({{"Viscous strain", std::string("deviatoric")}});
+  EXPECT_EQ(deviatoric.viscous_strain, ViscousStrain::deviatoric);
+  for (const auto& spec : OldroydBParameters::table().specs())
+    if (spec.name == "Viscous strain") EXPECT_EQ(spec.choices, (std::vector<std::string>{"full", "deviatoric"}));
 }

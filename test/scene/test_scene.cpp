@@ -115,7 +115,8 @@ TEST(Scene, EveryModelValidatesItsParametersNamingTheMaterialAndTheParameter) {
       {"herschel_bulkley", "Plastic viscosity", "0"}, {"herschel_bulkley", "Yield stress", "-0.1"},
       {"bingham", "Yield stress", "-1"},             {"neo_hookean", "Density", "0"},
       {"svd_plasticity", "Critical compression", "1"}, {"svd_plasticity", "Critical stretch", "0"},
-      {"von_mises", "Yield stress", "0"},            {"von_mises", "Hardening modulus", "-5"}};
+      {"von_mises", "Yield stress", "0"},            {"von_mises", "Hardening modulus", "-5"},
+      {"oldroyd_b", "Viscous strain", "volumetric"}, {"herschel_bulkley", "Viscous strain", "dev"}};
   // The default scene with its material replaced by one of `model` with default parameters.
   auto with_model = [](const std::string& model) {
     const std::string text = read_text(default_scene);

@@ -1,5 +1,6 @@
-// Every model of the registry in every variant (strain updates, viscosity conventions, flow
-// indices, hardening and softening): the one list the derivative tests and bench_materials share.
+// Every model of the registry in every variant (strain updates, viscosity conventions, viscous
+// strains, flow indices, hardening and softening): the one list the derivative tests and
+// bench_materials share.
 #pragma once
 
 #include <memory>
@@ -35,10 +36,18 @@ inline std::vector<ModelVariant> model_variants(double stress_scale = 1.0) {
       out.push_back({"oldroyd_b_" + update + "_" + convention, "oldroyd_b",
                      with({{"Strain update", update}, {"Viscosity convention", convention},
                            {"Newtonian viscosity", 0.3 * s}, {"Weissenberg number", 0.8}})});
+  // (5.11) on dev ε̂ only ("Viscous strain"), for each update in the paper convention.
+  for (std::string update : {"paper", "spd", "f_e"})
+    out.push_back({"oldroyd_b_" + update + "_paper_deviatoric", "oldroyd_b",
+                   with({{"Strain update", update}, {"Viscosity convention", "paper"}, {"Viscous strain", "deviatoric"},
+                         {"Newtonian viscosity", 0.3 * s}, {"Weissenberg number", 0.8}})});
   for (double h : {0.5, 1.0, 2.0})
     out.push_back({"herschel_bulkley_h" + std::to_string(h), "herschel_bulkley",
                    with({{"Yield stress", 0.3 * s}, {"Plastic viscosity", 0.7 * s}, {"Flow index", h},
                          {"Newtonian viscosity", 0.2 * s}})});
+  out.push_back({"herschel_bulkley_h1_deviatoric", "herschel_bulkley",
+                 with({{"Yield stress", 0.3 * s}, {"Plastic viscosity", 0.7 * s}, {"Viscous strain", "deviatoric"},
+                       {"Newtonian viscosity", 0.2 * s}})});
   out.push_back({"bingham", "bingham", with({{"Yield stress", 0.2 * s}, {"Plastic viscosity", 0.5 * s}})});
   out.push_back({"neo_hookean", "neo_hookean", elastic});
   out.push_back({"neo_hookean_negative_lambda", "neo_hookean", with({{"Lame lambda", -1.5 * s}})});

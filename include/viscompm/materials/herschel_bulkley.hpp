@@ -1,6 +1,7 @@
 // The Herschel–Bulkley-like fluid of §4.6.2 (Bingham for h = 1, §4.2.4; shear thinning for h < 1
 // and thickening for h > 1, §4.2.5): the Chapter 5 energy (5.8) of b^E = (J/J_HB)^{2/3} b_HB with
-// the Newtonian potential (5.11), b_HB updated by the positive-definite scheme
+// the Newtonian potential (5.11) (on ε̂ or on dev ε̂: "Viscous strain", as oldroyd_b), b_HB updated
+// by the positive-definite scheme
 //   (1 + a) b_HB^{n+1} = (I + A) b_HB^n (I + A)^T + a (tr b_HB^n / 3) I,
 //   a = (2Δt/3) tr(b̂) max(0, (‖dev b̂‖ − σ_Y)/η)^{1/h} / ‖dev b̂‖,
 // with the flow rule evaluated on the unimodular b̂ = b_HB / det(b_HB)^{1/3} (the b̂_e of §4.2.4,

@@ -6,6 +6,8 @@
 // plus the Newtonian viscous potential (5.11) in one of two conventions (doc/numerics.md):
 //   paper:    Φ^N = μ^N ε̂:ε̂ V^n        (μ^N acts as a viscosity μ^N / Δt)
 //   physical: Φ^N = Δt η ε̂:ε̂ V^n       (σ^N = 2 η ε, independent of Δt)
+// on ε̂ itself ("Viscous strain" full, the thesis) or on dev ε̂ only (deviatoric: no viscous
+// resistance to a change of volume).
 #pragma once
 
 #include <Eigen/Core>
@@ -38,16 +40,20 @@ struct Coefficients {
   double lambda = 0.0;
   double viscous = 0.0;   ///< c_N: μ^N (paper) or Δt η (physical)
   double J_n = 1.0;       ///< det(F^n): Φ^N integrates over the time-n volume V^n = J^n V^0
+  ViscousStrain viscous_strain = ViscousStrain::full;  ///< Φ^N of ε̂ (full) or of dev ε̂ (deviatoric)
 };
+
+/// The part of ε̂ the viscous potential acts on: ε̂ (full) or dev ε̂ = ε̂ − (tr ε̂/3) I.
+Mat3 viscous_strain(const Coefficients& c, const Mat3& eps);
 
 /// ∂Ψ/∂y as three matrices.
 struct EnergyGradient {
   Mat3 F, S, eps;
 };
-/// The non-zero blocks of ∂²Ψ/∂y² (the ε block is a multiple of the identity).
+/// The non-zero blocks of ∂²Ψ/∂y² (the ε block is 2 c_N J^n times the identity, full, or times
+/// the deviatoric projector I − vec(I) vec(I)ᵀ/3, deviatoric).
 struct EnergyHessian {
-  Mat9 FF, FS, SS;
-  double eps_eps = 0.0;
+  Mat9 FF, FS, SS, eps_eps;
 };
 
 /// det F > 0, det S > 0 and tr S > 0 (§5.7).

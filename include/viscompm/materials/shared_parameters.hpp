@@ -1,6 +1,7 @@
 // Parameters several models share, declared once here: the density and Lamé parameters of every
 // model, with the check that they describe a stable material (μ ≥ 0 and a positive bulk modulus
-// λ + 2μ/3), and the Newtonian viscosity of (5.11) with its convention (doc/numerics.md).
+// λ + 2μ/3), and the Newtonian viscosity of (5.11) with its convention and the part of ε̂ it acts
+// on (doc/numerics.md).
 #pragma once
 
 #include <algorithm>
@@ -41,13 +42,19 @@ inline double viscous_coefficient(ViscosityConvention convention, double viscosi
   return convention == ViscosityConvention::paper ? viscosity : dt * viscosity;
 }
 
+/// The strain rate the Newtonian potential (5.11) acts on: ε̂ itself (full, the thesis), which also
+/// resists a change of volume with a bulk viscosity 2c_N/3, or its deviatoric part dev ε̂ =
+/// ε̂ − (tr ε̂/3) I, which leaves the volume to the elastic response alone.
+enum class ViscousStrain { full, deviatoric };
+
 struct NewtonianParameters {
   double newtonian_viscosity = 0.0;              ///< μ^N (paper) or η (physical)
   ViscosityConvention viscosity_convention = ViscosityConvention::physical;
+  ViscousStrain viscous_strain = ViscousStrain::full;
 };
 
-/// Declares Newtonian viscosity and Viscosity convention on the table of a struct derived from
-/// NewtonianParameters.
+/// Declares Newtonian viscosity, Viscosity convention and Viscous strain on the table of a struct
+/// derived from NewtonianParameters.
 template <class P>
 void add_newtonian_parameters(ParameterTable<P>& table) {
   table.real(static_cast<double P::*>(&NewtonianParameters::newtonian_viscosity), "Newtonian viscosity", 0.0,
@@ -55,7 +62,11 @@ void add_newtonian_parameters(ParameterTable<P>& table) {
       .choice(static_cast<ViscosityConvention P::*>(&NewtonianParameters::viscosity_convention),
               "Viscosity convention", ViscosityConvention::physical,
               {{"paper", ViscosityConvention::paper}, {"physical", ViscosityConvention::physical}},
-              "paper: Φ^N = μ^N ε̂:ε̂ V^n exactly as (5.11); physical: σ^N = 2ηε");
+              "paper: Φ^N = μ^N ε̂:ε̂ V^n exactly as (5.11); physical: σ^N = 2ηε")
+      .choice(static_cast<ViscousStrain P::*>(&NewtonianParameters::viscous_strain), "Viscous strain",
+              ViscousStrain::full, {{"full", ViscousStrain::full}, {"deviatoric", ViscousStrain::deviatoric}},
+              "what (5.11) acts on: full, ε̂ as the thesis (the volume rate resisted too); deviatoric, dev ε̂ "
+              "only (the volume left to the elastic response)");
 }
 
 /// A problem with one parameter found by a cross-parameter check.
