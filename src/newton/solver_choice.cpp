@@ -94,14 +94,10 @@ void SolverChoice::next_trial_candidate() {
   ++trials_;
   // The margin: how many times the winner's cost the closest loser's step cost (at least; a
   // stopped one's is a lower bound).
-  margin_ = 0.0;
   loser_cost_ = std::numeric_limits<double>::infinity();
   for (int c = 0; c < candidates_; ++c)
     if (c != best) loser_cost_ = std::min(loser_cost_, trial_cost_[c]);
-  for (int c = 0; c < candidates_; ++c)
-    if (c != best && trial_cost_[best] > 0.0)
-      margin_ = margin_ == 0.0 ? trial_cost_[c] / trial_cost_[best] : std::min(margin_, trial_cost_[c] / trial_cost_[best]);
-  margin_ = std::max(margin_, 1.0);
+  margin_ = trial_cost_[best] > 0.0 && std::isfinite(loser_cost_) ? std::max(loser_cost_ / trial_cost_[best], 1.0) : 1.0;
   // A confirmed choice is checked half as often from now on; a new one as often as at first; and
   // never so often that the losers' trial steps cost more than `Trial overhead` of the winner's.
   interval_ = confirmed ? std::min(2 * interval_, settings_.max_recheck_steps) : settings_.recheck_steps;
