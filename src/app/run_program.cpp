@@ -88,7 +88,9 @@ int run_simulation_program(int argc, char** argv) {
       std::cout << solver.label() << ":";
       for (std::size_t k = 0; k < solver.candidates().size(); ++k)
         std::cout << (k == 0 ? " " : ", ") << solver.candidates()[k].label() << " " << choice->systems()[k] << " systems";
-      std::cout << "; " << choice->trials() << " trials, " << choice->switches() << " switches\n";
+      std::cout << "; " << choice->trials() << " trials, " << choice->switches() << " switches, "
+                << choice->warm_ups() << " second trial steps after a fresh set-up, " << choice->abandoned()
+                << " solves given up at their budget\n";
     }
     return exit_success;
   });

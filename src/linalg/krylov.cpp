@@ -2,6 +2,7 @@
 #include "preconditioner.hpp"
 
 #include <BelosSolverFactory.hpp>
+#include <algorithm>
 #include <chrono>
 
 namespace viscompm::linalg {
@@ -14,19 +15,26 @@ KrylovSolver::KrylovSolver(const SolverConfiguration& config) : config_(config) 
                            ? given.get<double>("Convergence Tolerance")
                            : solver_->getValidParameters()->get<double>("Convergence Tolerance");
   current_tolerance_ = default_tolerance_;
+  default_max_iterations_ = given.isParameter("Maximum Iterations")
+                                ? given.get<int>("Maximum Iterations")
+                                : solver_->getValidParameters()->get<int>("Maximum Iterations");
+  current_max_iterations_ = default_max_iterations_;
 }
 
 LinearSolveReport KrylovSolver::solve(const Teuchos::RCP<const operator_type>& A,
                                       const Teuchos::RCP<operator_type>& M, multivector_type& x,
-                                      const multivector_type& b, double tolerance) {
+                                      const multivector_type& b, double tolerance, int max_iterations) {
   LinearSolveReport report;
   report.preconditioner = config_.label();
   if (tolerance <= 0.0) tolerance = default_tolerance_;
-  if (tolerance != current_tolerance_) {
+  max_iterations = max_iterations <= 0 ? default_max_iterations_ : std::min(max_iterations, default_max_iterations_);
+  if (tolerance != current_tolerance_ || max_iterations != current_max_iterations_) {
     auto params = Teuchos::rcp(new Teuchos::ParameterList);
     params->set("Convergence Tolerance", tolerance);
+    params->set("Maximum Iterations", max_iterations);
     solver_->setParameters(params);
     current_tolerance_ = tolerance;
+    current_max_iterations_ = max_iterations;
   }
   report.tolerance = tolerance;
   x.putScalar(0.0);

@@ -233,13 +233,14 @@ std::uint64_t NewtonSystem::pattern_version() const { return impl_->pattern_vers
 
 double NewtonSystem::default_tolerance() const { return impl_->krylov.default_tolerance(); }
 
-LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) {
+LinearSolveReport NewtonSystem::solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance,
+                                      int max_iterations) {
   Impl& m = *impl_;
   require_preconditioner("solve");
   const auto& s = m.space.impl();
   multivector_type b(s.owned_dof_map, 1), x(s.owned_dof_map, 1);
   m.to_owned(rhs, b);
-  LinearSolveReport report = m.krylov.solve(m.hessian->op(), m.preconditioner_op(), x, b, tolerance);
+  LinearSolveReport report = m.krylov.solve(m.hessian->op(), m.preconditioner_op(), x, b, tolerance, max_iterations);
   m.from_owned(x, dv);
   return report;
 }

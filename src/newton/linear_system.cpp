@@ -13,8 +13,9 @@ class SimulationSystem : public LinearSystem {
   }
   double precondition() override { return system_.precondition(); }
   double prepare() override { return system_.prepare(); }
-  linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) override {
-    return system_.solve(rhs, dv, tolerance);
+  linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance,
+                                  int max_iterations) override {
+    return system_.solve(rhs, dv, tolerance, max_iterations);
   }
   void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z) override { system_.apply_preconditioner(r, z); }
   bool unpreconditioned() const override { return !system_.has_preconditioner(); }

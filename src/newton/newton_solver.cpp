@@ -11,6 +11,9 @@
 namespace viscompm::newton {
 
 namespace {
+// No pattern: a system not set up yet.
+constexpr std::uint64_t no_pattern = std::numeric_limits<std::uint64_t>::max();
+
 // The phases' timers (doc/architecture.md), all here.
 Teuchos::Time& timer(const char* name) { return *Teuchos::TimeMonitor::getNewCounter(name); }
 Teuchos::Time& assemble_timer() { static auto& t = timer("viscompm: 3a newton assemble"); return t; }
@@ -76,12 +79,15 @@ NewtonSolver::NewtonSolver(const NewtonSettings& settings, linalg::NewtonSystem&
   systems_.push_back(owned_systems_.back().get());
   rules_.emplace_back(settings);
   begun_.assign(1, false);
+  set_up_for_.assign(1, no_pattern);
+  seconds_per_iteration_.assign(1, -1.0);
 }
 
 NewtonSolver::NewtonSolver(const NewtonSettings& settings, LinearSystem& system, const parallel::Communicator& comm)
     : settings_(settings), systems_{&system}, comm_(comm), lbfgs_(settings.lbfgs_pairs) {
   rules_.emplace_back(settings);
   begun_.assign(1, false);
+  set_up_for_.assign(1, no_pattern);
 }
 
 NewtonSolver::NewtonSolver(const NewtonSettings& settings, const std::vector<linalg::NewtonSystem*>& candidates,
@@ -93,6 +99,8 @@ NewtonSolver::NewtonSolver(const NewtonSettings& settings, const std::vector<lin
     rules_.emplace_back(settings);
   }
   begun_.assign(systems_.size(), false);
+  set_up_for_.assign(systems_.size(), no_pattern);
+  seconds_per_iteration_.assign(systems_.size(), -1.0);
   choice_.emplace(static_cast<int>(systems_.size()), choice);
 }
 
@@ -120,14 +128,23 @@ NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential
   for (int direction = 0; direction < settings_.max_iterations; ++direction) {
     if (residual_settles(step, g) || stop_requested(step)) return finish();
     ++report.iterations;
-    const auto start = std::chrono::steady_clock::now();
-    select_candidate(step);
-    // Direction, then the line search along it (both inside: a failed line search may call for a
-    // fresh or projected Hessian).
-    const bool moved = settings_.method == Method::lbfgs ? lbfgs_direction_and_line_search(step, g, dv)
-                                                         : newton_direction_and_line_search(step, g, dv);
-    // What the direction cost, the slowest rank's, so that every rank chooses the same.
-    if (choice_) choice_->direction_solved(comm_.max(seconds_since(start)));
+    bool moved = false;
+    do {
+      direction_start_ = std::chrono::steady_clock::now();
+      fresh_setup_seconds_ = 0.0;
+      abandoned_ = false;
+      select_candidate(step);
+      // Direction, then the line search along it (both inside: a failed line search may call for a
+      // fresh or projected Hessian).
+      moved = settings_.method == Method::lbfgs ? lbfgs_direction_and_line_search(step, g, dv)
+                                                : newton_direction_and_line_search(step, g, dv);
+      // What the direction cost, the slowest rank's, so that every rank chooses the same. A
+      // direction given up at its budget is computed again by the candidate the choice names.
+      if (!choice_) break;
+      const double seconds = comm_.max(seconds_since(direction_start_)), fresh = comm_.max(fresh_setup_seconds_);
+      if (abandoned_) choice_->direction_abandoned(seconds, fresh);
+      else choice_->direction_solved(seconds, fresh);
+    } while (abandoned_);
     if (!moved) return finish();
   }
   if (!residual_settles(step, g) && report.failure.empty())
@@ -207,7 +224,11 @@ void NewtonSolver::assemble(Step& step, bool project) {
 
 void NewtonSolver::precondition(Step& step) {
   Teuchos::TimeMonitor t(precondition_timer());
-  step.report.linear_solves.back().setup_seconds += system().precondition();
+  const double seconds = system().precondition();
+  step.report.linear_solves.back().setup_seconds += seconds;
+  // A set-up on a pattern this system has not been set up on builds its preconditioner anew.
+  if (set_up_for_[current_] != system().pattern_version()) fresh_setup_seconds_ += seconds;
+  set_up_for_[current_] = system().pattern_version();
   ++step.report.preconditioner_setups;
   rules().preconditioned();
 }
@@ -227,6 +248,7 @@ bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVector
     if (k > 0 && stop_requested(step)) return false;
     bool used_kept = false;
     if (try_newton_direction(step, rhs, tolerance, attempt, dv, used_kept)) return true;
+    if (abandoned_) return false;  // a solve out of the choice's budget: not a failure of the step
     if (used_kept) {
       attempt = {true, always || (attempt.project && !adaptive)};
     } else if (!attempt.project && adaptive) {
@@ -262,10 +284,17 @@ bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, 
     Teuchos::TimeMonitor t(cg_timer());
     // The solve's report, with this attempt's assembly and set-up times kept.
     const double operator_seconds = solve.operator_seconds, setup_seconds = solve.setup_seconds;
-    solve = system().solve(rhs, dv, tolerance);
+    const int cap = budget_iteration_cap();
+    solve = system().solve(rhs, dv, tolerance, cap);
     solve.operator_seconds = operator_seconds;
     solve.setup_seconds = setup_seconds;
+    if (choice_ && solve.iterations > 0)
+      seconds_per_iteration_[current_] = comm_.max(solve.solve_seconds / solve.iterations);
+    // Every rank ran the same iterations: the same answer everywhere.
+    abandoned_ = cap > 0 && !solve.converged && solve.failure.empty() && solve.iterations >= cap;
+    if (abandoned_) solve.failure = "trial budget of " + std::to_string(cap) + " iterations spent";
   }
+  if (abandoned_) return false;
   report.projected_solves += attempt.project;
   rules().solved(solve.iterations, solve.tolerance);
 
@@ -276,6 +305,16 @@ bool NewtonSolver::try_newton_direction(Step& step, const NodeVectorField& rhs, 
   const bool usable = slope < 0.0 && (solve.converged || attempt.project ||
                                       settings_.hessian_projection == HessianProjection::never);
   return usable && line_search(step, dv, slope);
+}
+
+int NewtonSolver::budget_iteration_cap() const {
+  // Under a measured choice the solve may take the iterations its measured cost per iteration
+  // affords within the choice's budget (at least one): on trial, before its candidate has lost;
+  // the chosen one, before its step would start a trial at once. Without a bound, the file's limit.
+  if (!choice_ || seconds_per_iteration_[current_] <= 0.0) return 0;
+  const double budget = choice_->direction_budget(comm_.max(seconds_since(direction_start_)), comm_.max(fresh_setup_seconds_));
+  if (!std::isfinite(budget)) return 0;
+  return static_cast<int>(std::clamp(std::floor(budget / seconds_per_iteration_[current_]), 1.0, 1e9));
 }
 
 void NewtonSolver::rebuild_initial_inverse(Step& step) {

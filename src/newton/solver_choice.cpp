@@ -16,6 +16,8 @@ SolverChoice::SolverChoice(int candidates, const linalg::SolverChoiceSettings& s
     : settings_(settings),
       candidates_(candidates),
       trial_cost_(static_cast<std::size_t>(candidates), -1.0),
+      trial_fresh_(static_cast<std::size_t>(candidates), 0.0),
+      warmed_up_(static_cast<std::size_t>(candidates), false),
       systems_(static_cast<std::size_t>(candidates), 0),
       interval_(settings.recheck_steps) {
   if (candidates < 1) throw std::invalid_argument("SolverChoice: no candidate");
@@ -29,10 +31,11 @@ int SolverChoice::cheapest() const {
   return best;
 }
 
-void SolverChoice::direction_solved(double seconds) {
+void SolverChoice::direction_solved(double seconds, double fresh_setup_seconds) {
   ++systems_[next_];
   ++step_directions_;
   step_cost_ += seconds;
+  if (next_ == on_trial_) step_fresh_ += fresh_setup_seconds;
   // A candidate on trial that already cost more than the best step of this trial has lost: the
   // best one finishes the step.
   if (!in_trial_ || lost_ || next_ != on_trial_) return;
@@ -41,18 +44,64 @@ void SolverChoice::direction_solved(double seconds) {
     lost_ = true;
     ++stopped_early_;
     trial_cost_[on_trial_] = step_cost_;
+    trial_fresh_[on_trial_] = step_fresh_;
     next_ = best;
   }
+}
+
+double SolverChoice::direction_budget(double spent_seconds, double fresh_setup_seconds) const {
+  constexpr double unlimited = std::numeric_limits<double>::infinity();
+  if (!in_trial_) {
+    // The chosen one: until this one direction costs what would start a trial at once if it were
+    // a whole step (step_ended). Not the step's sum: a step of many cheap directions is no sign
+    // that the loser (its trial cost often a lower bound) would do it cheaper.
+    if (next_ != chosen_ || !std::isfinite(loser_cost_)) return unlimited;
+    return settings_.regime_change * std::max(reference_, loser_cost_) - spent_seconds;
+  }
+  // On trial: until it costs more than the best step of the trial so far.
+  const int best = cheapest();
+  if (lost_ || next_ != on_trial_ || best < 0) return unlimited;
+  const double held = warmed_up_[on_trial_] ? 0.0 : step_fresh_ + fresh_setup_seconds;
+  return trial_cost_[best] - (step_cost_ + spent_seconds - held);
+}
+
+void SolverChoice::direction_abandoned(double seconds, double fresh_setup_seconds) {
+  ++abandoned_;
+  if (!in_trial_ && next_ == chosen_) {
+    // The chosen one jumped out of its regime within a step: the closest loser finishes the step,
+    // and a trial starts with the next one.
+    direction_solved(seconds, fresh_setup_seconds);
+    jumped_within_step_ = true;
+    next_ = closest_loser_;
+    return;
+  }
+  const bool on_trial = in_trial_ && !lost_ && next_ == on_trial_;
+  direction_solved(seconds, fresh_setup_seconds);
+  if (!on_trial || lost_) return;
+  // Stopped a little before its cost passed the best's: it has lost all the same (and not by a
+  // fresh set-up, which its budget did not count).
+  const int best = cheapest();
+  lost_ = true;
+  warmed_up_[on_trial_] = true;
+  ++stopped_early_;
+  trial_cost_[on_trial_] = std::max(step_cost_, std::nextafter(trial_cost_[best], std::numeric_limits<double>::infinity()));
+  trial_fresh_[on_trial_] = step_fresh_;
+  next_ = best;
 }
 
 void SolverChoice::step_ended() {
   // A step whose initial guess already converged measured nothing.
   if (step_directions_ == 0) return;
   const double cost = step_cost_;
+  const double fresh = step_fresh_;
   step_cost_ = 0.0;
+  step_fresh_ = 0.0;
   step_directions_ = 0;
   if (in_trial_) {
-    if (!lost_) trial_cost_[on_trial_] = cost;
+    if (!lost_) {
+      trial_cost_[on_trial_] = cost;
+      trial_fresh_[on_trial_] = fresh;
+    }
     lost_ = false;
     next_trial_candidate();
     return;
@@ -68,7 +117,9 @@ void SolverChoice::step_ended() {
   // step cannot wait for the running mean: the loser may already be the cheaper (the pie's crust
   // reaching the head while the paper's solver is chosen). A step only dearer than its reference
   // (a hierarchy built anew) is left to the mean.
-  const bool jumped = cost > settings_.regime_change * std::max(reference_, loser_cost_);
+  const bool jumped = jumped_within_step_ || cost > settings_.regime_change * std::max(reference_, loser_cost_);
+  jumped_within_step_ = false;
+  next_ = chosen_;
   if (regime_changed || jumped) interval_ = settings_.recheck_steps;
   if (regime_changed || jumped || since_trial_ >= interval_) start_trial();
 }
@@ -77,6 +128,8 @@ void SolverChoice::start_trial() {
   if (candidates_ == 1) return;
   in_trial_ = true;
   std::fill(trial_cost_.begin(), trial_cost_.end(), -1.0);
+  std::fill(trial_fresh_.begin(), trial_fresh_.end(), 0.0);
+  std::fill(warmed_up_.begin(), warmed_up_.end(), false);
   trial_cost_[chosen_] = recent_;  // the chosen one is not run again: its recent cost stands for it
   next_trial_candidate();
 }
@@ -87,8 +140,20 @@ void SolverChoice::next_trial_candidate() {
       on_trial_ = next_ = c;
       return;
     }
-  // Every candidate measured: the cheapest is chosen.
-  const int best = cheapest();
+  // Every candidate measured. One that lost only by a preconditioner built anew on a new pattern
+  // (its first hierarchy of the run, or the first since the pattern changed while another solved)
+  // measured a one-off: it solves one more step, whose cost stands instead.
+  const int leader = cheapest();
+  for (int c = 0; c < candidates_; ++c)
+    if (c != leader && !warmed_up_[c] && trial_fresh_[c] > 0.0 && trial_cost_[c] - trial_fresh_[c] < trial_cost_[leader]) {
+      warmed_up_[c] = true;
+      ++warm_ups_;
+      trial_cost_[c] = -1.0;
+      trial_fresh_[c] = 0.0;
+      on_trial_ = next_ = c;
+      return;
+    }
+  const int best = leader;
   const bool confirmed = trials_ > 0 && best == chosen_;
   if (trials_ > 0 && best != chosen_) ++switches_;
   ++trials_;
@@ -96,7 +161,10 @@ void SolverChoice::next_trial_candidate() {
   // stopped one's is a lower bound).
   loser_cost_ = std::numeric_limits<double>::infinity();
   for (int c = 0; c < candidates_; ++c)
-    if (c != best) loser_cost_ = std::min(loser_cost_, trial_cost_[c]);
+    if (c != best && trial_cost_[c] < loser_cost_) {
+      loser_cost_ = trial_cost_[c];
+      closest_loser_ = c;
+    }
   margin_ = trial_cost_[best] > 0.0 && std::isfinite(loser_cost_) ? std::max(loser_cost_ / trial_cost_[best], 1.0) : 1.0;
   // A confirmed choice is checked half as often from now on; a new one as often as at first; and
   // never so often that the losers' trial steps cost more than `Trial overhead` of the winner's.

@@ -95,9 +95,9 @@ struct StiffSystem {
     integrator.newton_system().assemble(*objective->potential, objective->initial_guess, project);
     integrator.newton_system().precondition();
   }
-  linalg::LinearSolveReport solve() {
+  linalg::LinearSolveReport solve(int max_iterations = 0) {
     NodeVectorField dv;
-    return sim.integrator().newton_system().solve(rhs, dv);
+    return sim.integrator().newton_system().solve(rhs, dv, 0.0, max_iterations);
   }
   scene::SceneConfig scene;
   simulation::Simulation sim;
@@ -105,6 +105,24 @@ struct StiffSystem {
   NodeVectorField rhs;
 };
 }  // namespace
+
+TEST(SolverConfigurations, ASolveCappedByTheMeasuredChoiceStopsThereAndTheNextIsNot) {
+  // The measured choice's budget caps one solve's iterations (NewtonSolver, SolverChoice): that
+  // solve stops unconverged at the cap, and the solver file's own limit holds for the next one.
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  StiffSystem system(linalg::SolverConfiguration::read(solver_file("matrix_free_jacobi_cg.xml")), world);
+  system.assemble(1.0 / 24.0);
+  const auto full = system.solve();
+  ASSERT_TRUE(full.converged);
+  ASSERT_GT(full.iterations, 10);
+  const auto capped = system.solve(7);
+  EXPECT_EQ(capped.iterations, 7);
+  EXPECT_FALSE(capped.converged);
+  EXPECT_GT(capped.relative_residual, full.relative_residual);
+  const auto again = system.solve();
+  EXPECT_TRUE(again.converged);
+  EXPECT_EQ(again.iterations, full.iterations);
+}
 
 TEST(SolverConfigurations, TheStiffMultigridFilesSolveAStiffInclusionSystemOnAnyRankCount) {
   const parallel::Communicator world(MPI_COMM_WORLD);

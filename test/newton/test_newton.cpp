@@ -92,10 +92,11 @@ class FailingSystem : public newton::LinearSystem {
     calls += 'P';
     return real_->precondition();
   }
-  linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) override {
+  linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance,
+                                  int max_iterations) override {
     ++solves;
     calls += 'S';
-    if (!failing) return real_->solve(rhs, dv, tolerance);
+    if (!failing) return real_->solve(rhs, dv, tolerance, max_iterations);
     dv.resize(rhs.size());
     for (std::size_t i = 0; i < rhs.size(); ++i) dv[i] = -rhs[i];  // +∇E: uphill
     linalg::LinearSolveReport report;

@@ -3,6 +3,7 @@
 // doubling schedule, a regime change followed, and little more cost than the best fixed choice.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 
 #include "viscompm/newton/solver_choice.hpp"
@@ -211,4 +212,126 @@ TEST(SolverChoice, OneStepDearerThanItsReferenceOnlyDoesNotStartATrial) {
   run(choice, 1, cost, 2);  // the dear step
   EXPECT_EQ(choice.next(), 0) << "no trial of the paper's solver";
   EXPECT_EQ(choice.trials(), 1);
+}
+
+namespace {
+// One step of `directions` directions of candidate next(), costing `step_seconds` in all, the first
+// direction carrying `fresh` seconds of a preconditioner built anew.
+void step(SolverChoice& choice, double step_seconds, double fresh = 0.0, int directions = 3) {
+  for (int d = 0; d < directions; ++d)
+    choice.direction_solved(step_seconds / directions + (d == 0 ? fresh : 0.0), d == 0 ? fresh : 0.0);
+  choice.step_ended();
+}
+}  // namespace
+
+TEST(SolverChoice, ACandidateThatLostOnlyByAFreshSetUpSolvesOneMoreTrialStep) {
+  // The pie at Table 5.1's cell: the multigrid's first step costs 75 s, 44.5 s of it its first
+  // hierarchy; the paper's solver's 48 s. Without the fresh build the multigrid's step was 30.5 s,
+  // so it solves the next step too, with its hierarchy reused (38 s), and that step decides.
+  SolverChoice choice(2, SolverChoiceSettings{});
+  EXPECT_EQ(choice.next(), 0);
+  step(choice, 30.5, 44.5);
+  EXPECT_EQ(choice.next(), 1);
+  step(choice, 48.0);
+  EXPECT_EQ(choice.next(), 0) << "a second trial step for the multigrid";
+  EXPECT_EQ(choice.warm_ups(), 1);
+  EXPECT_EQ(choice.trials(), 0) << "the trial is not over yet";
+  step(choice, 38.0);
+  EXPECT_EQ(choice.trials(), 1);
+  EXPECT_EQ(choice.chosen(), 0);
+  EXPECT_EQ(choice.next(), 0);
+}
+
+TEST(SolverChoice, TheSecondTrialStepStandsEvenWhenItLosesAgain) {
+  // The same, but the multigrid's second step (reused hierarchy) costs 55 s > 48 s: it is stopped
+  // as soon as it has lost, and the paper's solver is chosen; no third step.
+  SolverChoice choice(2, SolverChoiceSettings{});
+  step(choice, 30.5, 44.5);
+  step(choice, 48.0);
+  EXPECT_EQ(choice.next(), 0);
+  choice.direction_solved(25.0);
+  choice.direction_solved(25.0);  // 50 s > 48 s: lost
+  EXPECT_EQ(choice.stopped_early(), 1);
+  EXPECT_EQ(choice.next(), 1) << "the paper's solver finishes the step";
+  choice.direction_solved(5.0);
+  choice.step_ended();
+  EXPECT_EQ(choice.trials(), 1);
+  EXPECT_EQ(choice.chosen(), 1);
+  EXPECT_EQ(choice.warm_ups(), 1);
+}
+
+TEST(SolverChoice, AFreshSetUpThatDidNotDecideTheTrialEarnsNoSecondStep) {
+  // 75 s with 10 s of fresh set-up against 48 s: it lost by more than its fresh build.
+  SolverChoice choice(2, SolverChoiceSettings{});
+  step(choice, 65.0, 10.0);
+  step(choice, 48.0);
+  EXPECT_EQ(choice.trials(), 1);
+  EXPECT_EQ(choice.chosen(), 1);
+  EXPECT_EQ(choice.warm_ups(), 0);
+  // A trial candidate stopped early by its fresh build is given its second step too: the paper's
+  // solver first (48 s), then the multigrid's first direction alone costs 60 s, 50 of them fresh.
+  SolverChoice stopped(2, SolverChoiceSettings{});
+  stopped.direction_solved(48.0);
+  stopped.step_ended();  // candidate 0 (here the paper's solver): 48 s
+  EXPECT_EQ(stopped.next(), 1);
+  stopped.direction_solved(60.0, 50.0);  // lost, but only by its fresh build
+  EXPECT_EQ(stopped.stopped_early(), 1);
+  EXPECT_EQ(stopped.next(), 0);
+  stopped.direction_solved(1.0);
+  stopped.step_ended();
+  EXPECT_EQ(stopped.next(), 1) << "the multigrid's second trial step";
+  step(stopped, 30.0);
+  EXPECT_EQ(stopped.chosen(), 1);
+  EXPECT_EQ(stopped.warm_ups(), 1);
+}
+
+TEST(SolverChoice, ATrialDirectionHasTheBudgetLeftBeforeItsCandidateLoses) {
+  // The multigrid chosen at 35 s per step; the paper's solver on trial spends 17 s on its first
+  // direction: its second may take 18 s more before it has lost. Given up there, it has lost and
+  // the multigrid computes that direction again; outside the trial there is no budget.
+  SolverChoice choice(2, SolverChoiceSettings{});
+  EXPECT_TRUE(std::isinf(choice.direction_budget(0.0))) << "nothing measured yet";
+  step(choice, 35.0);
+  EXPECT_EQ(choice.next(), 1);
+  EXPECT_DOUBLE_EQ(choice.direction_budget(5.0), 30.0);
+  choice.direction_solved(17.0);
+  EXPECT_DOUBLE_EQ(choice.direction_budget(0.0), 18.0);
+  EXPECT_DOUBLE_EQ(choice.direction_budget(4.0, 10.0), 24.0) << "a fresh set-up is not held against it yet";
+  choice.direction_abandoned(16.0);  // 33 s: stopped before it passed 35 s, lost all the same
+  EXPECT_EQ(choice.abandoned(), 1);
+  EXPECT_EQ(choice.stopped_early(), 1);
+  EXPECT_EQ(choice.next(), 0);
+  EXPECT_TRUE(std::isinf(choice.direction_budget(0.0))) << "the best one has no budget";
+  choice.direction_solved(10.0);
+  choice.step_ended();
+  EXPECT_EQ(choice.chosen(), 0);
+  EXPECT_EQ(choice.warm_ups(), 0) << "a direction given up at its budget earns no second step";
+  EXPECT_EQ(choice.systems(), (std::vector<int>{4, 2}));
+}
+
+TEST(SolverChoice, AChosenDirectionOutOfItsRegimeIsGivenUpAndTheLoserTried) {
+  // The paper's solver chosen (20 s per step against the multigrid's 25 s); at the impact one of
+  // its solves would take 110 s. A direction's budget is the step cost that starts a trial at
+  // once, 2 × 25 s, whatever the step's earlier directions cost: given up there, the multigrid
+  // computes the rest of the step and is tried on the next.
+  SolverChoice choice(2, SolverChoiceSettings{});
+  step(choice, 25.0);  // the multigrid (candidate 0)
+  step(choice, 20.0);  // the paper's solver
+  ASSERT_EQ(choice.chosen(), 1);
+  EXPECT_EQ(choice.next(), 1);
+  choice.direction_solved(12.0);
+  EXPECT_DOUBLE_EQ(choice.direction_budget(3.0), 50.0 - 3.0);
+  for (int d = 0; d < 5; ++d) choice.direction_solved(12.0);  // a step of many cheap directions: 72 s
+  EXPECT_EQ(choice.next(), 1);
+  EXPECT_DOUBLE_EQ(choice.direction_budget(3.0), 50.0 - 3.0);
+  choice.direction_abandoned(50.0);  // one direction spent its budget
+  EXPECT_EQ(choice.abandoned(), 1);
+  EXPECT_EQ(choice.next(), 0) << "the closest loser computes the direction again";
+  EXPECT_TRUE(std::isinf(choice.direction_budget(0.0)));
+  choice.direction_solved(5.0);
+  choice.step_ended();
+  EXPECT_EQ(choice.next(), 0) << "and is tried on the next step";
+  step(choice, 25.0);
+  EXPECT_EQ(choice.chosen(), 0) << "25 s against the paper solver's recent cost";
+  EXPECT_EQ(choice.switches(), 1);
 }

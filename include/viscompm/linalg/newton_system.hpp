@@ -45,7 +45,7 @@ class NewtonSystem {
   /// Solves H dv = rhs from dv = 0 to the relative residual `tolerance` (≤ 0: the solver file's)
   /// with the last preconditioner, which must have been set up for the current pattern
   /// (std::logic_error otherwise); rhs on the owned nodes, dv returned on all local nodes.
-  LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance = 0.0);
+  LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance = 0.0, int max_iterations = 0);
   /// z = P⁻¹ r, one application of the current preconditioner (set up as for solve; z = r
   /// without one); r on the owned nodes, z returned on all local nodes. Collective.
   void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z);

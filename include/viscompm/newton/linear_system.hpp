@@ -22,8 +22,10 @@ class LinearSystem {
   virtual double assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) = 0;
   /// Sets the preconditioner up for the current H; seconds.
   virtual double precondition() = 0;
-  /// Solves H dv = rhs to the relative residual `tolerance` with the current preconditioner.
-  virtual linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance) = 0;
+  /// Solves H dv = rhs to the relative residual `tolerance` with the current preconditioner, in at
+  /// most `max_iterations` Krylov iterations (≤ 0: the solver file's limit).
+  virtual linalg::LinearSolveReport solve(const NodeVectorField& rhs, NodeVectorField& dv, double tolerance,
+                                          int max_iterations) = 0;
   /// z = P⁻¹ r: one application of the current preconditioner (the identity if there is none).
   virtual void apply_preconditioner(const NodeVectorField& r, NodeVectorField& z) = 0;
   /// True if there is no preconditioner (apply_preconditioner is the identity).

@@ -8,6 +8,8 @@
 // linalg/.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -103,6 +105,8 @@ class NewtonSolver {
   bool try_newton_direction(Step& step, const NodeVectorField& rhs, double tolerance, const Attempt& attempt,
                             NodeVectorField& dv, bool& used_kept);
   bool lbfgs_direction_and_line_search(Step& step, const NodeVectorField& g, NodeVectorField& dv);
+  /// The iterations the solve may take within the measured choice's budget (0: no limit).
+  int budget_iteration_cap() const;
   void rebuild_initial_inverse(Step& step);
   bool line_search(Step& step, const NodeVectorField& dv, double slope);
   void trial_point(Step& step, const NodeVectorField& dv, double alpha) const;
@@ -125,6 +129,11 @@ class NewtonSolver {
   std::function<bool()> interrupt_;
   std::vector<ReuseRules> rules_;       ///< per system: what it keeps
   std::vector<bool> begun_;             ///< per system: its rules began this step's solve
+  std::vector<std::uint64_t> set_up_for_;  ///< per system: the pattern its last preconditioner was set up on
+  double fresh_setup_seconds_ = 0.0;    ///< this direction's set-ups on a new pattern (for the choice)
+  std::chrono::steady_clock::time_point direction_start_;  ///< when this direction began
+  std::vector<double> seconds_per_iteration_;  ///< per system: its Krylov iterations' recent cost (< 0: none yet)
+  bool abandoned_ = false;              ///< this direction's solve ran out of the choice's budget
   int current_ = 0;
   std::optional<SolverChoice> choice_;
   LbfgsMemory lbfgs_;

@@ -14,7 +14,12 @@
 // at once when the chosen one's cost per step moves by more than the factor `Regime change`, or
 // the margin the loser lost by if larger, from what it cost when last confirmed (a soft body met
 // a stiff one), or when a single step of it costs `Regime change` times both that and the
-// closest loser's trial step. A trial that finds a cheaper candidate switches to it.
+// closest loser's trial step. A trial that finds a cheaper candidate switches to it. A candidate
+// that lost its trial step only by a preconditioner built anew (a first hierarchy costs several
+// reused set-ups) solves one more step, and that step's cost stands for it. Within a step, a
+// direction has a budget (direction_budget): a trial's until its candidate has lost, the chosen
+// one's until the direction alone costs what, as a step, would start a trial at once; a Krylov solve that spends it is given up and
+// the direction computed by the best candidate (the chosen one's: by the closest loser).
 #pragma once
 
 #include <cstddef>
@@ -31,8 +36,18 @@ class SolverChoice {
   /// The candidate that computes the next direction.
   int next() const { return next_; }
   /// The direction computed by next() took `seconds` (the same value on every rank: the caller
-  /// agrees it).
-  void direction_solved(double seconds);
+  /// agrees it), of which `fresh_setup_seconds` built a preconditioner anew on a new pattern.
+  void direction_solved(double seconds, double fresh_setup_seconds = 0.0);
+  /// The seconds the direction under way may still take, given what it has spent so far
+  /// (`fresh_setup_seconds` of it on a fresh set-up): on trial, before its candidate has lost (a
+  /// fresh set-up not held against it before its second trial step); for the chosen one, before
+  /// this one direction costs what starts a trial at once as a step's cost (`Regime change` times
+  /// both its reference and the closest loser's trial step). Infinite when nothing bounds it (the first trial's first step).
+  double direction_budget(double spent_seconds, double fresh_setup_seconds = 0.0) const;
+  /// The direction under way was given up (its solve ran out of direction_budget()). On trial: the
+  /// candidate has lost, and the best one computes the direction again. The chosen one: the
+  /// closest loser computes it and the rest of the step, and a trial starts with the next step.
+  void direction_abandoned(double seconds, double fresh_setup_seconds = 0.0);
   /// The step's Newton solve ended (converged or not: a failed step's cost counts too; a step
   /// without a direction, converged at its initial guess, counts for nothing).
   void step_ended();
@@ -46,6 +61,10 @@ class SolverChoice {
   int trials() const { return trials_; }
   int switches() const { return switches_; }
   int stopped_early() const { return stopped_early_; }
+  /// Extra trial steps given to candidates that lost only by a fresh set-up.
+  int warm_ups() const { return warm_ups_; }
+  /// Directions given up when their solve ran out of direction_budget().
+  int abandoned() const { return abandoned_; }
 
  private:
   void start_trial();
@@ -60,18 +79,25 @@ class SolverChoice {
   int on_trial_ = 0;                   ///< the candidate whose trial step this is
   bool lost_ = false;                  ///< it was stopped this step
   std::vector<double> trial_cost_;     ///< per candidate, its step's cost in the current trial (< 0: not yet)
+  std::vector<double> trial_fresh_;    ///< per candidate, the fresh set-up seconds in its trial step
+  std::vector<bool> warmed_up_;        ///< per candidate, it was given a second trial step this trial
   double step_cost_ = 0.0;             ///< the current step's cost so far
+  double step_fresh_ = 0.0;            ///< of it, preconditioners built anew by the candidate on trial
   int step_directions_ = 0;            ///< and its directions
   std::vector<int> systems_;           ///< directions computed by each candidate
   double reference_ = 0.0;             ///< the chosen one's cost per step when last confirmed
   double recent_ = 0.0;                ///< its recent cost per step (a running mean)
   double margin_ = 1.0;                ///< the closest loser's cost over the winner's, last trial
   double loser_cost_ = 0.0;            ///< the closest loser's step cost, last trial (a lower bound if stopped)
+  int closest_loser_ = 0;              ///< the candidate of loser_cost_
+  bool jumped_within_step_ = false;    ///< the chosen one's direction was given up this step
   int since_trial_ = 0;                ///< steps of the chosen one since the last trial
   int interval_ = 0;                   ///< steps until the next trial
   int trials_ = 0;
   int switches_ = 0;
   int stopped_early_ = 0;
+  int warm_ups_ = 0;
+  int abandoned_ = 0;
 };
 
 }  // namespace viscompm::newton
