@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Times two commands in alternation (A B A B ...) and prints each one's wall, CPU and peak memory
 (min, median, max) and the ratio A/B taken pair by pair, so that a machine whose speed drifts
 during the runs still gives a meaningful ratio. Quote the medians.

@@ -2,6 +2,11 @@
 # The measurements of doc/performance.md, one after the other on an otherwise idle machine.
 # Usage: bench/run_benchmarks.sh [OUTPUT_DIR]   (after scripts/demo.sh or scripts/test.sh built)
 set -euo pipefail
+if [[ ${1:-} == -h || ${1:-} == --help ]]; then
+  echo "usage: bench/run_benchmarks.sh [OUTPUT_DIR]"
+  echo "Builds the benchmark targets and runs doc/performance.md's measurements into OUTPUT_DIR (default output/bench)."
+  exit 0
+fi
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="${1:-$ROOT/output/bench}"
 BIN="$ROOT/build/bin"

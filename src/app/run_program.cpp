@@ -5,6 +5,7 @@
 #include <cstring>
 #include <iostream>
 
+#include "viscompm/app/malloc_tuning.hpp"
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/environment.hpp"
 #include "viscompm/scene/command_line.hpp"
@@ -38,6 +39,7 @@ int run_with_exit_codes(const std::string& program, const parallel::Communicator
 }
 
 int run_simulation_program(int argc, char** argv) {
+  run_with_huge_pages(argv);
   linalg::Environment environment(&argc, &argv);
   install_stop_handlers();
   const parallel::Communicator comm(MPI_COMM_WORLD);

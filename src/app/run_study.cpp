@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "viscompm/app/malloc_tuning.hpp"
 #include "viscompm/app/run_program.hpp"
 #include "viscompm/core/error.hpp"
 #include "viscompm/linalg/environment.hpp"
@@ -29,6 +30,7 @@ std::string plot_script(const std::string& name) {
 }  // namespace
 
 int run_study_program(int argc, char** argv) {
+  run_with_huge_pages(argv);
   linalg::Environment environment(&argc, &argv);
   const parallel::Communicator comm(MPI_COMM_WORLD);
   const bool root = comm.is_root();

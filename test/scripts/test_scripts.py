@@ -24,6 +24,7 @@ from script_checks import check, finish  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--scripts", required=True, help="the scripts/ folder")
+parser.add_argument("--bench", help="the bench/ folder: its programs answer --help the same way")
 parser.add_argument("--workdir", required=True)
 parser.add_argument("--seed", type=int, default=24)
 args = parser.parse_args()
@@ -234,13 +235,16 @@ else:
         bad(f"render.sh: {what}", render + [directory, "--style", "spheres", "--size", "64x48", "--no-movie"], path)
 
 # ---------------------------------------------------------------------------------------------
-# Every program under scripts/ runs by its own name, as the docs write it (scripts/NAME --help):
+# Every program under scripts/ (and bench/) runs by its own name, as the docs write it (scripts/NAME --help):
 # executable, its interpreter the one scripts/setup.sh installs the modules for (Debian's
 # /usr/bin/python3, not the first python3 on PATH), and --help answered with its usage, exit 0,
 # nothing built (a build directory given in the environment is not made).
 not_built = os.path.join(work, "no_build_for_help")
-for name in sorted(os.listdir(scripts)):
-    path = os.path.join(scripts, name)
+programs = [os.path.join(scripts, name) for name in sorted(os.listdir(scripts))]
+if args.bench:
+    programs += [os.path.join(os.path.abspath(args.bench), name) for name in sorted(os.listdir(args.bench))]
+for path in programs:
+    name = os.path.relpath(path, os.path.dirname(scripts))
     if not os.path.isfile(path):
         continue
     with open(path, "rb") as f:
