@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <system_error>
 #include <unistd.h>
 
 namespace viscompm::app {
@@ -17,8 +19,12 @@ void run_with_huge_pages(char** argv) {
 #ifdef __GLIBC__
   const auto tunables = huge_page_tunables(std::getenv("GLIBC_TUNABLES"), std::getenv("VISCOMPM_HUGE_PAGES"));
   if (!tunables) return;
+  // The program's own file, not /proc/self/exe: the process keeps its name (ps, /proc/PID/comm).
+  std::error_code error;
+  const std::string program = std::filesystem::read_symlink("/proc/self/exe", error).string();
+  if (error || program.empty()) return;
   if (setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
-  execv("/proc/self/exe", argv);
+  execv(program.c_str(), argv);
   unsetenv("GLIBC_TUNABLES");  // the exec failed: on as before (setenv copied nothing else)
 #else
   (void)argv;

@@ -16,7 +16,8 @@ namespace viscompm::app {
 /// may be null); nullopt when nothing is to change.
 std::optional<std::string> huge_page_tunables(const char* glibc_tunables, const char* viscompm_huge_pages);
 
-/// Re-executes the program (/proc/self/exe, the same argv) with huge_page_tunables() in its
+/// Re-executes the program (the file /proc/self/exe names, so that the process keeps its name;
+/// the same argv) with huge_page_tunables() in its
 /// environment when it changes anything and glibc is the C library; returns if it does not (or
 /// the exec fails: the run goes on without).
 void run_with_huge_pages(char** argv);
