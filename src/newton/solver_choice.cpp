@@ -38,15 +38,17 @@ void SolverChoice::direction_solved(double seconds, double fresh_setup_seconds) 
   if (next_ == on_trial_) step_fresh_ += fresh_setup_seconds;
   // A candidate on trial that already cost more than the best step of this trial has lost: the
   // best one finishes the step.
-  if (!in_trial_ || lost_ || next_ != on_trial_) return;
+  if (!trial_step_running()) return;
   const int best = cheapest();
-  if (best >= 0 && step_cost_ > trial_cost_[best]) {
-    lost_ = true;
-    ++stopped_early_;
-    trial_cost_[on_trial_] = step_cost_;
-    trial_fresh_[on_trial_] = step_fresh_;
-    next_ = best;
-  }
+  if (best >= 0 && step_cost_ > trial_cost_[best]) lose_trial(best, step_cost_);
+}
+
+void SolverChoice::lose_trial(int best, double cost) {
+  lost_ = true;
+  ++stopped_early_;
+  trial_cost_[on_trial_] = cost;
+  trial_fresh_[on_trial_] = step_fresh_;
+  next_ = best;
 }
 
 double SolverChoice::direction_budget(double spent_seconds, double fresh_setup_seconds) const {
@@ -60,7 +62,7 @@ double SolverChoice::direction_budget(double spent_seconds, double fresh_setup_s
   }
   // On trial: until it costs more than the best step of the trial so far.
   const int best = cheapest();
-  if (lost_ || next_ != on_trial_ || best < 0) return unlimited;
+  if (!trial_step_running() || best < 0) return unlimited;
   const double held = warmed_up_[on_trial_] ? 0.0 : step_fresh_ + fresh_setup_seconds;
   return trial_cost_[best] - (step_cost_ + spent_seconds - held);
 }
@@ -75,18 +77,14 @@ void SolverChoice::direction_abandoned(double seconds, double fresh_setup_second
     next_ = closest_loser_;
     return;
   }
-  const bool on_trial = in_trial_ && !lost_ && next_ == on_trial_;
+  const bool on_trial = trial_step_running();
   direction_solved(seconds, fresh_setup_seconds);
   if (!on_trial || lost_) return;
   // Stopped a little before its cost passed the best's: it has lost all the same (and not by a
   // fresh set-up, which its budget did not count).
   const int best = cheapest();
-  lost_ = true;
   warmed_up_[on_trial_] = true;
-  ++stopped_early_;
-  trial_cost_[on_trial_] = std::max(step_cost_, std::nextafter(trial_cost_[best], std::numeric_limits<double>::infinity()));
-  trial_fresh_[on_trial_] = step_fresh_;
-  next_ = best;
+  lose_trial(best, std::max(step_cost_, std::nextafter(trial_cost_[best], std::numeric_limits<double>::infinity())));
 }
 
 void SolverChoice::step_ended() {

@@ -70,6 +70,10 @@ class SolverChoice {
   void start_trial();
   void next_trial_candidate();
   int cheapest() const;
+  /// The candidate on trial is computing this step's directions (it has not lost yet).
+  bool trial_step_running() const { return in_trial_ && !lost_ && next_ == on_trial_; }
+  /// It has lost at `cost` (a lower bound if stopped early): the best one finishes the step.
+  void lose_trial(int best, double cost);
 
   linalg::SolverChoiceSettings settings_;
   int candidates_;
