@@ -17,6 +17,7 @@ SolverChoice::SolverChoice(int candidates, const linalg::SolverChoiceSettings& s
       candidates_(candidates),
       trial_cost_(static_cast<std::size_t>(candidates), -1.0),
       trial_fresh_(static_cast<std::size_t>(candidates), 0.0),
+      trial_per_direction_(static_cast<std::size_t>(candidates), 0.0),
       warmed_up_(static_cast<std::size_t>(candidates), false),
       systems_(static_cast<std::size_t>(candidates), 0),
       interval_(settings.recheck_steps) {
@@ -48,6 +49,7 @@ void SolverChoice::lose_trial(int best, double cost) {
   ++stopped_early_;
   trial_cost_[on_trial_] = cost;
   trial_fresh_[on_trial_] = step_fresh_;
+  trial_per_direction_[on_trial_] = cost / step_directions_;
   next_ = best;
 }
 
@@ -92,6 +94,7 @@ void SolverChoice::step_ended() {
   if (step_directions_ == 0) return;
   const double cost = step_cost_;
   const double fresh = step_fresh_;
+  const int directions = step_directions_;
   step_cost_ = 0.0;
   step_fresh_ = 0.0;
   step_directions_ = 0;
@@ -99,23 +102,32 @@ void SolverChoice::step_ended() {
     if (!lost_) {
       trial_cost_[on_trial_] = cost;
       trial_fresh_[on_trial_] = fresh;
+      trial_per_direction_[on_trial_] = cost / directions;
     }
     lost_ = false;
     next_trial_candidate();
     return;
   }
-  // The chosen one: its recent cost, and a trial when it is due or the cost left its regime.
-  recent_ = since_trial_ == 0 ? cost : (1.0 - recent_weight) * recent_ + recent_weight * cost;
+  // The chosen one: its recent cost per step and per direction, and a trial when it is due or
+  // the cost per direction left its regime.
+  const double per_direction = cost / directions;
+  const auto mean = [this](double previous, double newest) {
+    return since_trial_ == 0 ? newest : (1.0 - recent_weight) * previous + recent_weight * newest;
+  };
+  recent_ = mean(recent_, cost);
+  recent_per_direction_ = mean(recent_per_direction_, per_direction);
   ++since_trial_;
   // A change smaller than the margin the loser lost by cannot reverse the choice.
   const double factor = std::max(settings_.regime_change, margin_);
-  const bool regime_changed = since_trial_ >= settings_.regime_steps &&
-                              (recent_ > factor * reference_ || recent_ * factor < reference_);
-  // One step that cost the regime factor times both its reference and the closest loser's trial
-  // step cannot wait for the running mean: the loser may already be the cheaper (the pie's crust
-  // reaching the head while the paper's solver is chosen). A step only dearer than its reference
-  // (a hierarchy built anew) is left to the mean.
-  const bool jumped = jumped_within_step_ || cost > settings_.regime_change * std::max(reference_, loser_cost_);
+  const bool regime_changed =
+      since_trial_ >= settings_.regime_steps && (recent_per_direction_ > factor * reference_per_direction_ ||
+                                                 recent_per_direction_ * factor < reference_per_direction_);
+  // One step whose directions cost the regime factor times both the reference's and the closest
+  // loser's trial directions cannot wait for the running mean: the loser may already be the
+  // cheaper (the pie's crust reaching the head while the paper's solver is chosen). A step only
+  // dearer than its reference (a hierarchy built anew) is left to the mean.
+  const bool jumped = jumped_within_step_ || per_direction > settings_.regime_change *
+                                                                 std::max(reference_per_direction_, loser_per_direction_);
   jumped_within_step_ = false;
   next_ = chosen_;
   if (regime_changed || jumped) interval_ = settings_.recheck_steps;
@@ -128,7 +140,9 @@ void SolverChoice::start_trial() {
   std::fill(trial_cost_.begin(), trial_cost_.end(), -1.0);
   std::fill(trial_fresh_.begin(), trial_fresh_.end(), 0.0);
   std::fill(warmed_up_.begin(), warmed_up_.end(), false);
-  trial_cost_[chosen_] = recent_;  // the chosen one is not run again: its recent cost stands for it
+  // The chosen one is not run again: its recent cost stands for it.
+  trial_cost_[chosen_] = recent_;
+  trial_per_direction_[chosen_] = recent_per_direction_;
   next_trial_candidate();
 }
 
@@ -164,6 +178,7 @@ void SolverChoice::next_trial_candidate() {
       closest_loser_ = c;
     }
   margin_ = trial_cost_[best] > 0.0 && std::isfinite(loser_cost_) ? std::max(loser_cost_ / trial_cost_[best], 1.0) : 1.0;
+  loser_per_direction_ = std::isfinite(loser_cost_) ? trial_per_direction_[closest_loser_] : 0.0;
   // A confirmed choice is checked half as often from now on; a new one as often as at first; and
   // never so often that the losers' trial steps cost more than `Trial overhead` of the winner's.
   interval_ = confirmed ? std::min(2 * interval_, settings_.max_recheck_steps) : settings_.recheck_steps;
@@ -171,6 +186,7 @@ void SolverChoice::next_trial_candidate() {
   interval_ = std::max(interval_, static_cast<int>(std::min<double>(affordable, settings_.max_recheck_steps)));
   chosen_ = next_ = best;
   reference_ = recent_ = trial_cost_[best];
+  reference_per_direction_ = recent_per_direction_ = trial_per_direction_[best];
   since_trial_ = 0;
   in_trial_ = false;
 }

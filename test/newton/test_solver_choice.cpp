@@ -335,3 +335,24 @@ TEST(SolverChoice, AChosenDirectionOutOfItsRegimeIsGivenUpAndTheLoserTried) {
   EXPECT_EQ(choice.chosen(), 0) << "25 s against the paper solver's recent cost";
   EXPECT_EQ(choice.switches(), 1);
 }
+
+TEST(SolverChoice, AStepOfMoreNewtonDirectionsAtTheSameCostPerDirectionStartsNoTrial) {
+  // The pie at Δx 0.01: the multigrid's trial step is 3 directions in 0.54 s; the paper's solver
+  // is stopped after 2 directions in 0.6 s. When the crust meets the head a step needs 9 Newton
+  // directions at 0.15 s each, 1.35 s: dearer than twice both step costs, but no dearer per
+  // direction, so the paper's solver (which needs those 9 directions too) is not tried.
+  SolverChoice choice(2, SolverChoiceSettings{});
+  step(choice, 0.54);
+  choice.direction_solved(0.05);
+  choice.direction_solved(0.55);
+  ASSERT_EQ(choice.stopped_early(), 1);
+  choice.direction_solved(0.1);
+  choice.step_ended();
+  ASSERT_EQ(choice.chosen(), 0);
+  for (int k = 0; k < 3; ++k) step(choice, 1.35, 0.0, 9);  // 0.15 s per direction
+  EXPECT_EQ(choice.next(), 0) << "no trial";
+  EXPECT_EQ(choice.trials(), 1);
+  // Dearer per direction than twice both trials' (0.18 s and 0.3 s) does start one: 0.7 s.
+  step(choice, 2.1, 0.0, 3);
+  EXPECT_EQ(choice.next(), 1);
+}

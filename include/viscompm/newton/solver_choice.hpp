@@ -11,10 +11,12 @@
 // for it) after `Recheck steps` steps, an interval that doubles (to `Max recheck steps`) each
 // time a trial confirms the choice and is never shorter than the losers' trial steps can pay for
 // (their excess over the winner at most `Trial overhead` of the winner's steps in between); or
-// at once when the chosen one's cost per step moves by more than the factor `Regime change`, or
-// the margin the loser lost by if larger, from what it cost when last confirmed (a soft body met
-// a stiff one), or when a single step of it costs `Regime change` times both that and the
-// closest loser's trial step. A trial that finds a cheaper candidate switches to it. A candidate
+// at once when the chosen one's cost per direction moves by more than the factor `Regime change`,
+// or the margin the loser lost by if larger, from what it cost when last confirmed (a soft body
+// met a stiff one), or when a single step's directions cost on average `Regime change` times both
+// that and the closest loser's trial directions. Per direction, not per step: a step that needs
+// more Newton iterations (the crust's impact) needs them whichever candidate solves it, so it is
+// no sign that the loser became the cheaper. A trial that finds a cheaper candidate switches to it. A candidate
 // that lost its trial step only by a preconditioner built anew (a first hierarchy costs several
 // reused set-ups) solves one more step, and that step's cost stands for it. Within a step, a
 // direction has a budget (direction_budget): a trial's until its candidate has lost, the chosen
@@ -84,6 +86,7 @@ class SolverChoice {
   bool lost_ = false;                  ///< it was stopped this step
   std::vector<double> trial_cost_;     ///< per candidate, its step's cost in the current trial (< 0: not yet)
   std::vector<double> trial_fresh_;    ///< per candidate, the fresh set-up seconds in its trial step
+  std::vector<double> trial_per_direction_;  ///< per candidate, its trial step's cost per direction (of those done)
   std::vector<bool> warmed_up_;        ///< per candidate, it was given a second trial step this trial
   double step_cost_ = 0.0;             ///< the current step's cost so far
   double step_fresh_ = 0.0;            ///< of it, preconditioners built anew by the candidate on trial
@@ -91,6 +94,9 @@ class SolverChoice {
   std::vector<int> systems_;           ///< directions computed by each candidate
   double reference_ = 0.0;             ///< the chosen one's cost per step when last confirmed
   double recent_ = 0.0;                ///< its recent cost per step (a running mean)
+  double reference_per_direction_ = 0.0;  ///< the chosen one's cost per direction when last confirmed
+  double recent_per_direction_ = 0.0;     ///< its recent cost per direction (a running mean of steps' averages)
+  double loser_per_direction_ = 0.0;      ///< the closest loser's trial cost per direction
   double margin_ = 1.0;                ///< the closest loser's cost over the winner's, last trial
   double loser_cost_ = 0.0;            ///< the closest loser's step cost, last trial (a lower bound if stopped)
   int closest_loser_ = 0;              ///< the candidate of loser_cost_
