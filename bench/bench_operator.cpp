@@ -62,7 +62,7 @@ double best_of(int repetitions, const parallel::Communicator& comm, F&& f) {
 // What one run measures (the slowest rank's best of `repetitions`).
 struct OperatorTimes {
   double layout_with_graph, layout_kept, hessians_exact, hessians_projected, assembly_exact, assembly, spmv;
-  double rows, nonzeros, spmv_bytes, mf_setup, mf_apply, triad;
+  double rows, nonzeros, spmv_bytes, mf_setup, mf_apply, triad, block_spmv, block_convert;
   long long own, ghosts, nodes;
 };
 
@@ -94,6 +94,7 @@ OperatorTimes measure(simulation::Simulation& sim, double dt, int repetitions, c
   t.assembly_exact = best_of(repetitions, comm, [&] { assembled.assemble(potential, v0, false); });
   t.assembly = best_of(repetitions, comm, [&] { assembled.assemble(potential, v0, true); });
   t.spmv = assembled.time_apply(20);
+  t.block_spmv = assembled.time_block_apply(20, t.block_convert);
   t.rows = static_cast<double>(assembled.global_rows());
   t.nonzeros = static_cast<double>(assembled.global_nonzeros());
   t.spmv_bytes = t.nonzeros * (8.0 + 4.0) + t.rows * (8.0 + 8.0 + 8.0);
@@ -125,6 +126,8 @@ void print(const OperatorTimes& t, const char* scene_file, double dx, double dt_
   std::printf("assembly (values), projected   %10.4f s   elements and scatter %.4f s\n", t.assembly,
               t.assembly - t.hessians_projected);
   std::printf("assembled SpMV                 %10.5f s   %.2f GB/s\n", t.spmv, t.spmv_bytes / t.spmv / 1e9);
+  std::printf("block SpMV (3x3 BlockCrsMatrix) %10.5f s   conversion %.4f s; block / point SpMV %.2f\n", t.block_spmv,
+              t.block_convert, t.block_spmv / t.spmv);
   std::printf("matrix-free set-up (H_p, diag) %10.4f s\n", t.mf_setup);
   std::printf("matrix-free H·v                %10.5f s\n", t.mf_apply);
   std::printf("triad                                        %.2f GB/s\n", t.triad / 1e9);

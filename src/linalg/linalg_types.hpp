@@ -13,6 +13,7 @@
 #include <MueLu_SmootherBase_fwd.hpp>
 #include <MueLu_Ifpack2Smoother_fwd.hpp>
 #include <MueLu_TrilinosSmoother_fwd.hpp>
+#include <Tpetra_BlockCrsMatrix_fwd.hpp>
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_RowMatrix_fwd.hpp>
 #include <Xpetra_Matrix_fwd.hpp>
@@ -40,6 +41,7 @@ using vector_type = Tpetra::Vector<scalar_type, local_ordinal_type, global_ordin
 using operator_type = Tpetra::Operator<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 using crs_graph_type = Tpetra::CrsGraph<local_ordinal_type, global_ordinal_type, node_type>;
 using crs_matrix_type = Tpetra::CrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
+using block_crs_matrix_type = Tpetra::BlockCrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 using fe_graph_type = Tpetra::FECrsGraph<local_ordinal_type, global_ordinal_type, node_type>;
 using fe_matrix_type = Tpetra::FECrsMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;
 using row_matrix_type = Tpetra::RowMatrix<scalar_type, local_ordinal_type, global_ordinal_type, node_type>;

@@ -77,6 +77,10 @@ class NewtonSystem {
                            const NodeVectorField& v, const NodeVectorField& rhs) const;
   /// Seconds per application of H (mean of `repetitions`), for benchmarks (collective).
   double time_apply(int repetitions) const;
+  /// The same product with H stored as 3×3 blocks (Tpetra::BlockCrsMatrix converted from the
+  /// assembled matrix): seconds per application, and the conversion's seconds in
+  /// `convert_seconds`; for benchmarks (collective; assembled operators only).
+  double time_block_apply(int repetitions, double& convert_seconds) const;
   /// Seconds per application of the preconditioner (mean of `repetitions`; 0 without one): one
   /// V-cycle of a multigrid (collective; after precondition()).
   double time_preconditioner(int repetitions) const;
