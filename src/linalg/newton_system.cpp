@@ -319,16 +319,24 @@ void NewtonSystem::write_matrix_market(const std::string& prefix, const implicit
   write_contiguous_matrix_market(*matrix, b, *m.modes.coordinates, prefix);
 }
 
-double NewtonSystem::time_apply(int repetitions) const {
-  const Impl& m = *impl_;
-  multivector_type X(m.space.impl().owned_dof_map, 1), Y(m.space.impl().owned_dof_map, 1);
+namespace {
+// Seconds per application of `op` to a random vector (mean of `repetitions`, after one warm-up;
+// the ranks start and stop together).
+template <class Communicator>
+double mean_apply_seconds(const operator_type& op, const Communicator& comm, int repetitions) {
+  multivector_type X(op.getDomainMap(), 1), Y(op.getRangeMap(), 1);
   X.randomize();
-  m.hessian->op()->apply(X, Y);  // warm-up
-  m.space.comm().barrier();
+  op.apply(X, Y);  // warm-up
+  comm.barrier();
   const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < repetitions; ++k) m.hessian->op()->apply(X, Y);
-  m.space.comm().barrier();
+  for (int k = 0; k < repetitions; ++k) op.apply(X, Y);
+  comm.barrier();
   return seconds_since(start) / repetitions;
+}
+}  // namespace
+
+double NewtonSystem::time_apply(int repetitions) const {
+  return mean_apply_seconds(*impl_->hessian->op(), impl_->space.comm(), repetitions);
 }
 
 double NewtonSystem::time_block_apply(int repetitions, double& convert_seconds) const {
@@ -336,34 +344,18 @@ double NewtonSystem::time_block_apply(int repetitions, double& convert_seconds) 
   const auto matrix = m.hessian->matrix();
   if (matrix.is_null()) throw std::logic_error("NewtonSystem::time_block_apply: the operator is matrix-free");
   m.space.comm().barrier();
-  auto start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
   const auto blocks = Tpetra::convertToBlockCrsMatrix(*matrix, 3);
   m.space.comm().barrier();
   convert_seconds = seconds_since(start);
-  // The block matrix's own point maps (its mesh maps × 3) carry the vectors.
-  multivector_type X(blocks->getDomainMap(), 1), Y(blocks->getRangeMap(), 1);
-  X.randomize();
-  blocks->apply(X, Y);  // warm-up
-  m.space.comm().barrier();
-  start = std::chrono::steady_clock::now();
-  for (int k = 0; k < repetitions; ++k) blocks->apply(X, Y);
-  m.space.comm().barrier();
-  return seconds_since(start) / repetitions;
+  return mean_apply_seconds(*blocks, m.space.comm(), repetitions);
 }
 
 double NewtonSystem::time_preconditioner(int repetitions) const {
   const Impl& m = *impl_;
   require_preconditioner("time_preconditioner");
   const auto op = m.preconditioner_op();
-  if (op.is_null()) return 0.0;
-  multivector_type R(m.space.impl().owned_dof_map, 1), Z(m.space.impl().owned_dof_map, 1);
-  R.randomize();
-  op->apply(R, Z);  // warm-up
-  m.space.comm().barrier();
-  const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < repetitions; ++k) op->apply(R, Z);
-  m.space.comm().barrier();
-  return seconds_since(start) / repetitions;
+  return op.is_null() ? 0.0 : mean_apply_seconds(*op, m.space.comm(), repetitions);
 }
 
 }  // namespace viscompm::linalg

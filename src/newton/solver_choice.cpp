@@ -44,12 +44,16 @@ void SolverChoice::direction_solved(double seconds, double fresh_setup_seconds) 
   if (best >= 0 && step_cost_ > trial_cost_[best]) lose_trial(best, step_cost_);
 }
 
-void SolverChoice::lose_trial(int best, double cost) {
-  lost_ = true;
-  ++stopped_early_;
+void SolverChoice::record_trial_step(double cost) {
   trial_cost_[on_trial_] = cost;
   trial_fresh_[on_trial_] = step_fresh_;
   trial_per_direction_[on_trial_] = cost / step_directions_;
+}
+
+void SolverChoice::lose_trial(int best, double cost) {
+  lost_ = true;
+  ++stopped_early_;
+  record_trial_step(cost);
   next_ = best;
 }
 
@@ -92,18 +96,13 @@ void SolverChoice::direction_abandoned(double seconds, double fresh_setup_second
 void SolverChoice::step_ended() {
   // A step whose initial guess already converged measured nothing.
   if (step_directions_ == 0) return;
+  if (in_trial_ && !lost_) record_trial_step(step_cost_);
   const double cost = step_cost_;
-  const double fresh = step_fresh_;
   const int directions = step_directions_;
   step_cost_ = 0.0;
   step_fresh_ = 0.0;
   step_directions_ = 0;
   if (in_trial_) {
-    if (!lost_) {
-      trial_cost_[on_trial_] = cost;
-      trial_fresh_[on_trial_] = fresh;
-      trial_per_direction_[on_trial_] = cost / directions;
-    }
     lost_ = false;
     next_trial_candidate();
     return;

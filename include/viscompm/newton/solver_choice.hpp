@@ -16,8 +16,8 @@
 // met a stiff one), or when a single step's directions cost on average `Regime change` times both
 // that and the closest loser's trial directions. Per direction, not per step: a step that needs
 // more Newton iterations (the crust's impact) needs them whichever candidate solves it, so it is
-// no sign that the loser became the cheaper. A trial that finds a cheaper candidate switches to it. A candidate
-// that lost its trial step only by a preconditioner built anew (a first hierarchy costs several
+// no sign that the loser became the cheaper. A trial that finds a cheaper candidate switches to
+// it. A candidate that lost its trial step only by a preconditioner built anew (a first hierarchy costs several
 // reused set-ups) solves one more step, and that step's cost stands for it. Within a step, a
 // direction has a budget (direction_budget): a trial's until its candidate has lost, the chosen
 // one's until the direction alone costs what, as a step, would start a trial at once; a Krylov solve that spends it is given up and
@@ -74,6 +74,8 @@ class SolverChoice {
   int cheapest() const;
   /// The candidate on trial is computing this step's directions (it has not lost yet).
   bool trial_step_running() const { return in_trial_ && !lost_ && next_ == on_trial_; }
+  /// The candidate on trial's step cost `cost` (its fresh set-up and directions those of the step so far).
+  void record_trial_step(double cost);
   /// It has lost at `cost` (a lower bound if stopped early): the best one finishes the step.
   void lose_trial(int best, double cost);
 
