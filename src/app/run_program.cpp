@@ -92,7 +92,8 @@ int run_simulation_program(int argc, char** argv) {
         std::cout << (k == 0 ? " " : ", ") << solver.candidates()[k].label() << " " << choice->systems()[k] << " systems";
       std::cout << "; " << choice->trials() << " trials, " << choice->switches() << " switches, "
                 << choice->warm_ups() << " second trial steps after a fresh set-up, " << choice->abandoned()
-                << " solves given up at their budget\n";
+                << " solves given up at their budget, " << choice->confirmations()
+                << " steps of the chosen one after a regime change\n";
     }
     return exit_success;
   });

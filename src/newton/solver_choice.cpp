@@ -130,16 +130,18 @@ void SolverChoice::step_ended() {
   jumped_within_step_ = false;
   next_ = chosen_;
   if (regime_changed || jumped) interval_ = settings_.recheck_steps;
-  if (regime_changed || jumped || since_trial_ >= interval_) start_trial();
+  if (regime_changed || jumped || since_trial_ >= interval_) start_trial(regime_changed || jumped);
 }
 
-void SolverChoice::start_trial() {
+void SolverChoice::start_trial(bool confirm_chosen) {
   if (candidates_ == 1) return;
   in_trial_ = true;
+  confirm_chosen_ = confirm_chosen;
   std::fill(trial_cost_.begin(), trial_cost_.end(), -1.0);
   std::fill(trial_fresh_.begin(), trial_fresh_.end(), 0.0);
   std::fill(warmed_up_.begin(), warmed_up_.end(), false);
-  // The chosen one is not run again: its recent cost stands for it.
+  // The chosen one is not run again: its recent cost stands for it (after a regime change, until a
+  // loser beats it: then the chosen one solves a step of its own, next_trial_candidate).
   trial_cost_[chosen_] = recent_;
   trial_per_direction_[chosen_] = recent_per_direction_;
   next_trial_candidate();
@@ -151,10 +153,22 @@ void SolverChoice::next_trial_candidate() {
       on_trial_ = next_ = c;
       return;
     }
-  // Every candidate measured. One that lost only by a preconditioner built anew on a new pattern
+  // Every candidate measured. After a regime change the chosen one's recent cost may hold one
+  // outlier step (a process held stopped, a crowded machine): a loser that beat it does not win on
+  // that, the chosen one solves a step under the trial's budget and its cost stands instead. In a
+  // true regime change that costs at most about one step of the loser.
+  const int leader = cheapest();
+  if (confirm_chosen_ && leader != chosen_) {
+    confirm_chosen_ = false;
+    ++confirmations_;
+    trial_cost_[chosen_] = -1.0;
+    on_trial_ = next_ = chosen_;
+    return;
+  }
+  confirm_chosen_ = false;
+  // One that lost only by a preconditioner built anew on a new pattern
   // (its first hierarchy of the run, or the first since the pattern changed while another solved)
   // measured a one-off: it solves one more step, whose cost stands instead.
-  const int leader = cheapest();
   for (int c = 0; c < candidates_; ++c)
     if (c != leader && !warmed_up_[c] && trial_fresh_[c] > 0.0 && trial_cost_[c] - trial_fresh_[c] < trial_cost_[leader]) {
       warmed_up_[c] = true;

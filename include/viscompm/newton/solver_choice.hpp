@@ -14,7 +14,9 @@
 // at once when the chosen one's cost per direction moves by more than the factor `Regime change`,
 // or the margin the loser lost by if larger, from what it cost when last confirmed (a soft body
 // met a stiff one), or when a single step's directions cost on average `Regime change` times both
-// that and the closest loser's trial directions. Per direction, not per step: a step that needs
+// that and the closest loser's trial directions. In a trial a regime change started, the chosen
+// one's recent cost does not decide alone (one outlier step moves it: a process held stopped): if
+// a loser beats it, the chosen one solves a step too, under the trial's budget. Per direction, not per step: a step that needs
 // more Newton iterations (the crust's impact) needs them whichever candidate solves it, so it is
 // no sign that the loser became the cheaper. A trial that finds a cheaper candidate switches to
 // it. A candidate that lost its trial step only by a preconditioner built anew (a first hierarchy costs several
@@ -67,9 +69,14 @@ class SolverChoice {
   int warm_ups() const { return warm_ups_; }
   /// Directions given up when their solve ran out of direction_budget().
   int abandoned() const { return abandoned_; }
+  /// Trials after a regime change in which the chosen one solved a step again, a loser having
+  /// beaten its recent cost.
+  int confirmations() const { return confirmations_; }
 
  private:
-  void start_trial();
+  /// `confirm_chosen`: a regime change started it, so the chosen one's recent cost stands only
+  /// until a loser beats it, and then the chosen one solves a step of its own.
+  void start_trial(bool confirm_chosen = false);
   void next_trial_candidate();
   int cheapest() const;
   /// The candidate on trial is computing this step's directions (it has not lost yet).
@@ -102,6 +109,7 @@ class SolverChoice {
   double margin_ = 1.0;                ///< the closest loser's cost over the winner's, last trial
   double loser_cost_ = 0.0;            ///< the closest loser's step cost, last trial (a lower bound if stopped)
   int closest_loser_ = 0;              ///< the candidate of loser_cost_
+  bool confirm_chosen_ = false;        ///< this trial's chosen one solves a step if a loser beats its recent cost
   bool jumped_within_step_ = false;    ///< the chosen one's direction was given up this step
   int since_trial_ = 0;                ///< steps of the chosen one since the last trial
   int interval_ = 0;                   ///< steps until the next trial
@@ -110,6 +118,7 @@ class SolverChoice {
   int stopped_early_ = 0;
   int warm_ups_ = 0;
   int abandoned_ = 0;
+  int confirmations_ = 0;
 };
 
 }  // namespace viscompm::newton
