@@ -48,6 +48,8 @@ def main():
     if not a or args.runs < 1 or args.warmup < 0:
         parser.error("give -n >= 1, --warmup >= 0 and command A after --")
     b = shlex.split(args.vs)
+    if args.log_dir:
+        os.makedirs(args.log_dir, exist_ok=True)
     logs = [os.path.join(args.log_dir, name) if args.log_dir else None for name in ("A.log", "B.log")]
     for _ in range(args.warmup):
         run_once(a, logs[0])
