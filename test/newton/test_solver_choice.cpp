@@ -366,16 +366,24 @@ TEST(SolverChoice, AStepOfMoreNewtonDirectionsAtTheSameCostPerDirectionStartsNoT
   EXPECT_EQ(choice.next(), 1);
 }
 
+namespace {
+// The multigrid (candidate 0) at 10 s per step of 4 directions but 305 s at step 20 (the process
+// held stopped); the paper's solver (candidate 1) at `loser_step_seconds` per step.
+std::function<double(int, int)> outlier_costs(double loser_step_seconds) {
+  return [loser_step_seconds](int c, int step) {
+    if (c == 1) return loser_step_seconds / 4;
+    return step == 20 ? 305.0 / 4 : 10.0 / 4;
+  };
+}
+}  // namespace
+
 TEST(SolverChoice, OneOutlierStepOfTheChosenOneDoesNotHandTheLoserTheChoice) {
   // The pie at Δx 0.005 on one rank, the process held stopped during one step: the multigrid
   // (chosen, 10 s per step) "costs" 305 s once; the paper's solver's trial step takes 35 s, less
   // than the multigrid's running mean (which holds the 305 s). The multigrid solves a step again
   // under the 35 s, in its usual 10 s, and stays chosen: not 28 steps of the paper's solver at
   // 3.5× the cost, as with the running mean standing for it.
-  auto cost = [](int c, int step) {
-    if (c == 1) return 35.0 / 4;
-    return step == 20 ? 305.0 / 4 : 10.0 / 4;
-  };
+  const auto cost = outlier_costs(35.0);
   SolverChoice choice(2, SolverChoiceSettings{});
   run(choice, 20, cost);
   ASSERT_EQ(choice.chosen(), 0);
@@ -397,10 +405,7 @@ TEST(SolverChoice, ALoserDearerThanTheOutlierNeedsNoConfirmingStep) {
   // The same outlier against a loser dearer than even the running mean that holds it (the paper's
   // solver 12× the multigrid: 120 s per step, 83.75 s the mean): the trial stops the loser at
   // that mean, and the multigrid goes on without a confirming step.
-  auto cost = [](int c, int step) {
-    if (c == 1) return 120.0 / 4;
-    return step == 20 ? 305.0 / 4 : 10.0 / 4;
-  };
+  const auto cost = outlier_costs(120.0);
   SolverChoice choice(2, SolverChoiceSettings{});
   run(choice, 21, cost);
   EXPECT_EQ(choice.next(), 1);
