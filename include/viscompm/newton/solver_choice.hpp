@@ -16,9 +16,9 @@
 // met a stiff one), or when a single step's directions cost on average `Regime change` times both
 // that and the closest loser's trial directions. In a trial a regime change started, the chosen
 // one's recent cost does not decide alone (one outlier step moves it: a process held stopped): if
-// a loser beats it, the chosen one solves a step too, under the trial's budget. Per direction, not per step: a step that needs
-// more Newton iterations (the crust's impact) needs them whichever candidate solves it, so it is
-// no sign that the loser became the cheaper. A trial that finds a cheaper candidate switches to
+// a loser beats it, the chosen one solves a step too, under the trial's budget. Per direction,
+// not per step: a step that needs more Newton iterations (the crust's impact) needs them
+// whichever candidate solves it, so it is no sign that the loser became the cheaper. A trial that finds a cheaper candidate switches to
 // it. A candidate that lost its trial step only by a preconditioner built anew (a first hierarchy costs several
 // reused set-ups) solves one more step, and that step's cost stands for it. Within a step, a
 // direction has a budget (direction_budget): a trial's until its candidate has lost, the chosen
@@ -76,7 +76,7 @@ class SolverChoice {
  private:
   /// `confirm_chosen`: a regime change started it, so the chosen one's recent cost stands only
   /// until a loser beats it, and then the chosen one solves a step of its own.
-  void start_trial(bool confirm_chosen = false);
+  void start_trial(bool confirm_chosen);
   void next_trial_candidate();
   int cheapest() const;
   /// The candidate on trial is computing this step's directions (it has not lost yet).
