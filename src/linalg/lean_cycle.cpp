@@ -16,8 +16,8 @@ Teuchos::Time& coarse_timer() { static Teuchos::Time& t = timer("viscompm: lean 
 }  // namespace
 
 LeanCycle::LeanCycle(Teuchos::RCP<const operator_type> A, std::shared_ptr<const LineSmoother> smoother,
-                     Teuchos::RCP<muelu_hierarchy_type> hierarchy, int sweeps)
-    : A_(std::move(A)), smoother_(std::move(smoother)), hierarchy_(std::move(hierarchy)), sweeps_(sweeps) {
+                     Teuchos::RCP<muelu_hierarchy_type> hierarchy, const FineSmoothing& smoothing)
+    : A_(std::move(A)), smoother_(std::move(smoother)), hierarchy_(std::move(hierarchy)), smoothing_(smoothing) {
   const auto level = hierarchy_->GetLevel(1);
   P_ = muelu_utilities_type::Op2TpetraCrs(level->template Get<Teuchos::RCP<xpetra_matrix_type>>("P"));
   R_ = muelu_utilities_type::Op2TpetraCrs(level->template Get<Teuchos::RCP<xpetra_matrix_type>>("R"));
@@ -42,12 +42,43 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
     smoother_->apply(residual, correction);
     x.update(1.0, correction, 1.0);
   };
+  // Chebyshev steps x += p(B A) B (X − A x) (Saad, Alg. 12.1), from x = 0 when `from_zero`.
+  multivector_type direction(A_->getDomainMap(), k);
+  const auto chebyshev = [&](bool from_zero) {
+    const double upper = smoothing_.boost * smoother_->largest_eigenvalue(), lower = upper / smoothing_.ratio;
+    const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
+    double rho = 1.0 / sigma;
+    if (from_zero) {
+      Teuchos::TimeMonitor t(smoother_timer());
+      smoother_->apply_undamped(X, direction);
+    } else {
+      form_residual();
+      Teuchos::TimeMonitor t(smoother_timer());
+      smoother_->apply_undamped(residual, direction);
+    }
+    direction.scale(1.0 / theta);
+    if (from_zero) x.assign(direction);
+    else x.update(1.0, direction, 1.0);
+    for (int step = 1; step < smoothing_.steps; ++step) {
+      const double rho_next = 1.0 / (2.0 * sigma - rho);
+      form_residual();
+      Teuchos::TimeMonitor t(smoother_timer());
+      smoother_->apply_undamped(residual, correction);
+      direction.update(2.0 * rho_next / delta, correction, rho_next * rho);
+      x.update(1.0, direction, 1.0);
+      rho = rho_next;
+    }
+  };
   // Pre-smoothing: the first sweep from zero (x = S X, no product), then the rest.
-  {
-    Teuchos::TimeMonitor t(smoother_timer());
-    smoother_->apply(X, x);
+  if (smoothing_.chebyshev) {
+    chebyshev(true);
+  } else {
+    {
+      Teuchos::TimeMonitor t(smoother_timer());
+      smoother_->apply(X, x);
+    }
+    for (int s = 1; s < smoothing_.steps; ++s) sweep();
   }
-  for (int s = 1; s < sweeps_; ++s) sweep();
   // Coarse correction of the residual.
   form_residual();
   {
@@ -64,8 +95,10 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
     Teuchos::TimeMonitor t(transfer_timer());
     P_->apply(*coarse_x, x, Teuchos::NO_TRANS, 1.0, 1.0);
   }
-  // Post-smoothing: as many sweeps as before (the cycle stays symmetric).
-  for (int s = 0; s < sweeps_; ++s) sweep();
+  // Post-smoothing: as many steps as before (the cycle stays symmetric).
+  if (smoothing_.chebyshev) chebyshev(false);
+  else
+    for (int s = 0; s < smoothing_.steps; ++s) sweep();
   Y.update(alpha, x, beta);
 }
 

@@ -97,9 +97,9 @@ void LineSmoother::compute(const crs_matrix_type& A, const operator_type& apply_
     }
   }
   // The damping: Line damping over λmax(S A), by power iterations.
-  damping_ = 1.0;
-  damping_ = line_damping / smoothed_largest_eigenvalue(
-                                apply_A, [this](const vector_type& in, vector_type& out) { apply(in, out); }, eigenvector_);
+  largest_eigenvalue_ = smoothed_largest_eigenvalue(
+      apply_A, [this](const vector_type& in, vector_type& out) { apply_undamped(in, out); }, eigenvector_);
+  damping_ = line_damping / largest_eigenvalue_;
 }
 
 double smoothed_largest_eigenvalue(const operator_type& A, const std::function<void(const vector_type&, vector_type&)>& smooth,
@@ -143,13 +143,14 @@ void LineSmoother::solve_blocks(const In& x, Out& y, std::size_t j) const {
   }
 }
 
-void LineSmoother::apply(const multivector_type& x, multivector_type& y) const {
+void LineSmoother::apply_scaled(const multivector_type& x, multivector_type& y, double scale) const {
   auto xv = x.getLocalViewHost(Tpetra::Access::ReadOnly);
   auto yv = y.getLocalViewHost(Tpetra::Access::OverwriteAll);
   for (std::size_t j = 0; j < xv.extent(1); ++j) {
     for (std::size_t i = 0; i < xv.extent(0); ++i) yv(i, j) = 0.0;
     solve_blocks(xv, yv, j);
-    for (std::size_t i = 0; i < xv.extent(0); ++i) yv(i, j) *= damping_;
+    if (scale != 1.0)
+      for (std::size_t i = 0; i < xv.extent(0); ++i) yv(i, j) *= scale;
   }
 }
 

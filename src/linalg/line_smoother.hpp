@@ -32,10 +32,16 @@ class LineSmoother {
   /// after that (collective).
   void compute(const crs_matrix_type& A, const operator_type& apply_A, double line_damping);
   /// y = ω Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x on the owned dofs.
-  void apply(const multivector_type& x, multivector_type& y) const;
+  void apply(const multivector_type& x, multivector_type& y) const { apply_scaled(x, y, damping_); }
+  /// y = Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x: the blocks' inverse without the damping (a Chebyshev smoother's
+  /// preconditioner).
+  void apply_undamped(const multivector_type& x, multivector_type& y) const { apply_scaled(x, y, 1.0); }
   double damping() const { return damping_; }
+  /// λmax(Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ A) as the last compute() estimated it.
+  double largest_eigenvalue() const { return largest_eigenvalue_; }
 
  private:
+  void apply_scaled(const multivector_type& x, multivector_type& y, double scale) const;
   /// y += Σ_ℓ R_ℓᵀ B_ℓ⁻¹ R_ℓ x for column j (no damping).
   template <class In, class Out>
   void solve_blocks(const In& x, Out& y, std::size_t j) const;
@@ -58,6 +64,7 @@ class LineSmoother {
   std::vector<int> column_row_;                     // local column → local row (−1: ghost)
   std::vector<int> line_of_, position_of_;          // per node and axis: its line, its place on it
   double damping_ = 1.0;
+  double largest_eigenvalue_ = 1.0;
   Teuchos::RCP<vector_type> eigenvector_;  // of the last estimate
 };
 

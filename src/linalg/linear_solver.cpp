@@ -64,6 +64,14 @@ const ParameterTable<SolverSettings>& SolverSettings::table() {
         .integer(&S::fine_sweeps, "Fine sweeps", 1, Range::closed(1, 8),
                  "lean cycle: grid-line smoother sweeps before and after the coarse correction (each sweep past "
                  "the first costs one more product with the operator)")
+        .choice(&S::fine_chebyshev, "Fine smoother", false, {{"sweeps", false}, {"Chebyshev", true}},
+                "lean cycle: Fine sweeps damped line-smoother sweeps, or the Chebyshev iteration of degree Fine "
+                "sweeps on the undamped line blocks (the same products with the operator, a stronger smoothing)")
+        .real(&S::fine_chebyshev_ratio, "Fine Chebyshev ratio", 20.0, Range::at_least(1.0),
+              "Fine smoother = Chebyshev: the largest eigenvalue of (blocks⁻¹ H) over the smallest it targets")
+        .real(&S::fine_chebyshev_boost, "Fine Chebyshev boost", 1.1, Range::closed(1.0, 4.0),
+              "Fine smoother = Chebyshev: the power iterations' estimate of that eigenvalue is multiplied by this "
+              "(an underestimate would amplify the modes above it)")
         .choice(&S::deflation, "Deflation", Deflation::none,
                 {{"none", Deflation::none}, {"stiff bodies", Deflation::stiff_bodies}},
                 "stiff bodies: the 6 rigid motions of every stiff body (connected material whose elastic waves "

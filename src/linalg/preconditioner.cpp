@@ -475,7 +475,12 @@ class MueLuPreconditioner : public Preconditioner {
     if (pattern_changed || !lean_lines_)
       lean_lines_ = std::make_shared<LineSmoother>(grid::node_lines(grid_of(modes)->owned_nodes, settings.line_length));
     lean_lines_->compute(A, *H.op(), settings.line_damping);
-    lean_ = Teuchos::rcp(new LeanCycle(H.op(), lean_lines_, prec_->GetHierarchy(), settings.fine_sweeps));
+    FineSmoothing smoothing;
+    smoothing.steps = settings.fine_sweeps;
+    smoothing.chebyshev = settings.fine_chebyshev;
+    smoothing.ratio = settings.fine_chebyshev_ratio;
+    smoothing.boost = settings.fine_chebyshev_boost;
+    lean_ = Teuchos::rcp(new LeanCycle(H.op(), lean_lines_, prec_->GetHierarchy(), smoothing));
   }
 
   // The block relaxations on grid lines (pre- and post-smoother, one object or two) get their

@@ -44,7 +44,10 @@ struct SolverSettings {
   double line_damping = 1.5;
   int line_levels = 1;  ///< geometric hierarchies: the finest this many levels smooth on grid lines
   Cycle cycle = Cycle::muelu;
-  int fine_sweeps = 1;  ///< lean cycle: line-smoother sweeps before and after the coarse correction
+  int fine_sweeps = 1;  ///< lean cycle: line-smoother sweeps (or Chebyshev degree) before and after the coarse correction
+  bool fine_chebyshev = false;   ///< lean cycle: Chebyshev steps on the line blocks instead of damped sweeps
+  double fine_chebyshev_ratio = 20.0;
+  double fine_chebyshev_boost = 1.1;
   Deflation deflation = Deflation::none;
   double stiff_cfl = 30.0;    ///< c Δt/Δx from which a material counts as stiff (deflation)
   int max_stiff_bodies = 64;  ///< the largest this many bodies are deflated
