@@ -7,6 +7,26 @@
 
 namespace viscompm::linalg {
 
+namespace {
+// An operator counting the products Belos asks of it: a solve that throws (a breakdown) leaves the
+// manager's iteration count at the previous solve's, so the count of a failed solve is taken here.
+class CountingOperator : public operator_type {
+ public:
+  explicit CountingOperator(Teuchos::RCP<const operator_type> A) : A_(std::move(A)) {}
+  Teuchos::RCP<const map_type> getDomainMap() const override { return A_->getDomainMap(); }
+  Teuchos::RCP<const map_type> getRangeMap() const override { return A_->getRangeMap(); }
+  void apply(const multivector_type& X, multivector_type& Y, Teuchos::ETransp mode, scalar_type alpha,
+             scalar_type beta) const override {
+    ++products;
+    A_->apply(X, Y, mode, alpha, beta);
+  }
+  mutable int products = 0;
+
+ private:
+  Teuchos::RCP<const operator_type> A_;
+};
+}  // namespace
+
 KrylovSolver::KrylovSolver(const SolverConfiguration& config) : config_(config) {
   Belos::SolverFactory<scalar_type, multivector_type, operator_type> factory;
   solver_ = factory.create(config.impl().settings.krylov_solver, config.impl().krylov_parameters);
@@ -38,20 +58,24 @@ LinearSolveReport KrylovSolver::solve(const Teuchos::RCP<const operator_type>& A
   }
   report.tolerance = tolerance;
   x.putScalar(0.0);
+  const auto counted = Teuchos::rcp(new CountingOperator(A));
   auto problem = Teuchos::rcp(new Belos::LinearProblem<scalar_type, multivector_type, operator_type>(
-      A, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
+      counted, Teuchos::rcpFromRef(x), Teuchos::rcpFromRef(b)));
   if (!M.is_null()) problem->setLeftPrec(M);
   problem->setProblem();
   solver_->setProblem(problem);
+  counted->products = 0;  // the initial residual of setProblem is not an iteration
   const auto start = std::chrono::steady_clock::now();
   try {
     report.converged = solver_->solve() == Belos::Converged;
+    report.iterations = solver_->getNumIters();
   } catch (const std::exception& e) {
     report.converged = false;  // breakdown (e.g. an indefinite operator)
     report.failure = e.what();
+    // One product per CG iteration; the manager's own count is still the last solve's.
+    report.iterations = counted->products;
   }
   report.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  report.iterations = solver_->getNumIters();
 
   // The true residual, whatever the solver's own stopping rule measured.
   multivector_type r(b.getMap(), 1);

@@ -108,6 +108,7 @@ NewtonSolver::~NewtonSolver() = default;
 
 void NewtonSolver::forget() {
   for (auto& rules : rules_) rules.forget();
+  exact_failed_first_ = false;
 }
 
 NewtonReport NewtonSolver::solve(const implicit::IncrementalPotential& potential, NodeVectorField& v,
@@ -241,15 +242,34 @@ bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVector
   const bool always = settings_.hessian_projection == HessianProjection::always;
   // The attempts, in order: (1) as the strategy says — a kept or fresh H, exact unless projection
   // is always on or the kept H is projected; (2) a fresh H and preconditioner, if (1) used anything
-  // kept; (3) the fresh projected H, if the last H was exact and projection is adaptive.
+  // kept; (3) the fresh projected H, if the last H was exact and projection is adaptive. Where (1)
+  // was a fresh exact H with a kept preconditioner and projection is adaptive, (2) is the projected
+  // H with that preconditioner (SPD, so CG needs no new one: a set-up spared, often the price of a
+  // whole direction) and (3) the projected H with a fresh preconditioner.
   Attempt attempt{rules().assemble_now(), always};
   if (!attempt.fresh) attempt.project = rules().kept_projected();
+  // Once an exact H has failed as a step's first direction, later steps' first directions start
+  // from the projected H (the step's start is where the exact H is indefinite, and its failed
+  // attempt cost an assembly and a set-up); later directions of a step still try the exact H.
+  const bool first_direction = step.report.iterations == 1;
+  if (adaptive && first_direction && attempt.fresh && exact_failed_first_) attempt.project = true;
+  bool projected_with_kept_preconditioner = false;
   for (int k = 0; k < direction_attempts; ++k) {
     if (k > 0 && stop_requested(step)) return false;
     bool used_kept = false;
-    if (try_newton_direction(step, rhs, tolerance, attempt, dv, used_kept)) return true;
+    const bool ok = try_newton_direction(step, rhs, tolerance, attempt, dv, used_kept);
+    if (k == 0 && adaptive && first_direction && attempt.fresh && !attempt.project && !abandoned_)
+      exact_failed_first_ = !ok;
+    if (ok) return true;
     if (abandoned_) return false;  // a solve out of the choice's budget: not a failure of the step
-    if (used_kept) {
+    if (used_kept && adaptive && attempt.fresh && !attempt.project && !projected_with_kept_preconditioner) {
+      attempt = {true, true};
+      projected_with_kept_preconditioner = true;
+      continue;  // the preconditioner stays
+    }
+    if (projected_with_kept_preconditioner) {
+      attempt = {true, true};
+    } else if (used_kept) {
       attempt = {true, always || (attempt.project && !adaptive)};
     } else if (!attempt.project && adaptive) {
       attempt = {true, true};

@@ -462,6 +462,48 @@ TEST(SolverConfigurations, TheLeanCycleSetsUpOnAnIndefiniteHessian) {
               << " iterations\n";
 }
 
+TEST(SolverConfigurations, ABrokenDownSolveReportsItsOwnIterationsNotTheLastSolves) {
+  // Belos' CG throws when it meets a non-positive p·Ap (an indefinite H assembled unprojected), and
+  // its manager then still holds the previous solve's iteration count: solver.csv showed a solve
+  // that broke down at once with the iterations of the solve before it, and the measured choice's
+  // seconds per iteration and the reuse rules took that count. A breakdown must report the
+  // iterations it ran: the same after a long solve as in a system that solved nothing before.
+  const parallel::Communicator world(MPI_COMM_WORLD);
+  const auto config = linalg::SolverConfiguration::read(solver_file("matrix_free_jacobi_cg.xml"));
+  // The same stretches for the same particle whatever the order the particles are held in (the
+  // first assembly sorts them into cells): seeded by the particle's id.
+  auto crush = [](StiffSystem& system) {
+    auto& particles = system.sim.particles();
+    std::uniform_real_distribution<double> stretch(0.15, 3.0);
+    for (std::size_t p = 0; p < particles.size(); ++p) {
+      std::mt19937 crushing(static_cast<std::uint32_t>(5 + 7919 * particles.id[p]));
+      particles.deformation_gradient[p] =
+          Mat3(Eigen::Vector3d(stretch(crushing), stretch(crushing), stretch(crushing)).asDiagonal());
+    }
+  };
+  StiffSystem after_a_solve(config, world);
+  after_a_solve.assemble(1.0 / 24.0);
+  const auto long_solve = after_a_solve.solve();
+  ASSERT_TRUE(long_solve.converged);
+  ASSERT_GT(long_solve.iterations, 20);
+  crush(after_a_solve);
+  after_a_solve.assemble(1.0 / 24.0, /*project=*/false);
+  const auto broken = after_a_solve.solve();
+  ASSERT_FALSE(broken.failure.empty()) << "the crushed, unprojected H must break CG down for this test";
+  EXPECT_FALSE(broken.converged);
+
+  StiffSystem first(config, world);
+  crush(first);
+  first.assemble(1.0 / 24.0, /*project=*/false);
+  const auto broken_first = first.solve();
+  ASSERT_FALSE(broken_first.failure.empty());
+  EXPECT_EQ(broken.iterations, broken_first.iterations) << "a breakdown's count must not depend on the solve before it";
+  EXPECT_LT(broken.iterations, long_solve.iterations);
+  if (world.is_root())
+    std::cout << "  SPD solve " << long_solve.iterations << " iterations; breakdown after " << broken.iterations
+              << " (" << broken.failure.substr(0, 60) << ")\n";
+}
+
 TEST(SolverConfigurations, DeflatingTheStiffBodiesCutsTheIterationsOnAnyRankCount) {
   // The stiff inclusions' rigid motions are H's softest modes and straddle soft gaps no coarse
   // grid function resolves: on one rank (lines uncut) deflating them must cut the lean cycle's CG

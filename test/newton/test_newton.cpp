@@ -84,6 +84,8 @@ class FailingSystem : public newton::LinearSystem {
   double assemble(const implicit::IncrementalPotential& potential, const NodeVectorField& v, bool project) override {
     ++assemblies;
     projected_assemblies += project;
+    last_projected = project;
+    assembly_kinds += project ? 'p' : 'e';
     calls += 'A';
     return real_->assemble(potential, v, project);
   }
@@ -96,7 +98,7 @@ class FailingSystem : public newton::LinearSystem {
                                   int max_iterations) override {
     ++solves;
     calls += 'S';
-    if (!failing) return real_->solve(rhs, dv, tolerance, max_iterations);
+    if (!failing || (fail_exact_only && last_projected)) return real_->solve(rhs, dv, tolerance, max_iterations);
     dv.resize(rhs.size());
     for (std::size_t i = 0; i < rhs.size(); ++i) dv[i] = -rhs[i];  // +∇E: uphill
     linalg::LinearSolveReport report;
@@ -113,6 +115,9 @@ class FailingSystem : public newton::LinearSystem {
   std::string label() const override { return "failing"; }
 
   bool failing = true;
+  bool fail_exact_only = false;  // fail only the solves of an H assembled unprojected
+  bool last_projected = false;
+  std::string assembly_kinds;  // in order: e exact, p projected
   int assemblies = 0, projected_assemblies = 0, setups = 0, solves = 0;
   std::string calls;  // in order: A assembly, P preconditioner set-up, S solve
 
@@ -165,6 +170,55 @@ TEST_F(NewtonOnASpinningBlock, WhenEverySolveFailsEachDirectionEndsAfterAtMostTh
     // The kept H (no assembly), then a fresh exact and a fresh projected H, each preconditioned.
     EXPECT_EQ(failing.calls, kept_attempt + "APS" + "APS") << update;
   }
+}
+
+TEST_F(NewtonOnASpinningBlock, AnExactHessianFailingWithAKeptPreconditionerIsProjectedUnderThatPreconditioner) {
+  // Adaptive projection, H fresh at every iteration, the preconditioner set up once per step: when
+  // the exact H fails with the kept preconditioner (built for another H), the projected H is tried
+  // with that same preconditioner — it is SPD, so CG needs no new one — before anything is set up
+  // again. Every exact solve fails here: the first direction sets up twice (exact, then projected:
+  // nothing was kept), every later one is the exact attempt and the projected one, no set-up.
+  newton::NewtonSettings settings = scene.newton;
+  settings.hessian_projection = newton::HessianProjection::adaptive;
+  settings.hessian_update = newton::HessianUpdate::every_iteration;
+  settings.preconditioner_update = newton::PreconditionerUpdate::every_step;
+  FailingSystem exact_fails(sim.integrator().newton_system());
+  exact_fails.fail_exact_only = true;
+  newton::NewtonSolver solver(settings, exact_fails, comm);
+  const auto report = solver.solve(*objective->potential, v);
+  ASSERT_TRUE(report.converged) << report.failure;
+  ASSERT_GE(report.iterations, 3);
+  std::string expected = "APSAPS";
+  for (int k = 1; k < report.iterations; ++k) expected += "ASAS";
+  EXPECT_EQ(exact_fails.calls.substr(0, expected.size()), expected);
+  EXPECT_EQ(exact_fails.setups, 2);
+  EXPECT_EQ(report.preconditioner_setups, 2);
+}
+
+TEST_F(NewtonOnASpinningBlock, AfterAnExactHessianFailedAtAStepsStartLaterStepsStartProjected) {
+  // Adaptive projection: the exact H failed as the first direction of a step, so the next step's
+  // first direction assembles the projected H at once (an exact assembly, set-up and failed solve
+  // spared) and its later directions try the exact H again; forget() (a failed step, a
+  // checkpoint) returns to the exact start, so that a restart repeats the run.
+  newton::NewtonSettings settings = scene.newton;
+  settings.hessian_projection = newton::HessianProjection::adaptive;
+  FailingSystem exact_fails(sim.integrator().newton_system());
+  exact_fails.fail_exact_only = true;
+  newton::NewtonSolver solver(settings, exact_fails, comm);
+  NodeVectorField v_first = v;
+  ASSERT_TRUE(solver.solve(*objective->potential, v_first).converged);
+  EXPECT_EQ(exact_fails.assembly_kinds.substr(0, 2), "ep") << "the first step starts exact";
+  exact_fails.assembly_kinds.clear();
+  NodeVectorField v_second = v;
+  const auto second = solver.solve(*objective->potential, v_second);
+  ASSERT_TRUE(second.converged);
+  ASSERT_GE(second.iterations, 2);
+  EXPECT_EQ(exact_fails.assembly_kinds.substr(0, 3), "pep") << "projected first, then the exact H tried again";
+  solver.forget();
+  exact_fails.assembly_kinds.clear();
+  NodeVectorField v_third = v;
+  ASSERT_TRUE(solver.solve(*objective->potential, v_third).converged);
+  EXPECT_EQ(exact_fails.assembly_kinds.substr(0, 2), "ep") << "after forget() a step starts exact again";
 }
 
 TEST_F(NewtonOnASpinningBlock, AStopRequestBetweenAttemptsEndsTheSolve) {

@@ -134,6 +134,9 @@ class NewtonSolver {
   std::chrono::steady_clock::time_point direction_start_;  ///< when this direction began
   std::vector<double> seconds_per_iteration_;  ///< per system: its Krylov iterations' recent cost (< 0: none yet)
   bool abandoned_ = false;              ///< this direction's solve ran out of the choice's budget
+  /// Adaptive projection: an exact H failed as the first direction of a step since the last
+  /// forget(); later steps then start from the projected H.
+  bool exact_failed_first_ = false;
   int current_ = 0;
   std::optional<SolverChoice> choice_;
   LbfgsMemory lbfgs_;
