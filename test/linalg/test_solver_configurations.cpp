@@ -259,21 +259,33 @@ TEST(SolverConfigurations, EverySpellingOfBlockRelaxationGivesTheSameSmoother) {
 }
 
 namespace {
-// A shipped solver file with the string parameter `key` set to `value` at its top level.
-linalg::SolverConfiguration with_parameter(const std::string& name, const std::string& key, const std::string& value,
-                                           const std::string& type = "string") {
+// A shipped solver file with top-level parameters set: each (key, value, type) replaces the
+// file's entry or is added.
+struct TopLevelParameter {
+  std::string key, value, type = "string";
+};
+linalg::SolverConfiguration with_parameters(const std::string& name, const std::vector<TopLevelParameter>& parameters) {
   std::ifstream in(solver_file(name));
   std::stringstream text;
   text << in.rdbuf();
   std::string xml = text.str();
-  const std::string element = "<Parameter name=\"" + key + "\" type=\"" + type + "\" value=\"" + value + "\"/>";
-  if (const std::size_t old = xml.find("<Parameter name=\"" + key + "\""); old != std::string::npos) {
-    xml.replace(old, xml.find("/>", old) + 2 - old, element);
-  } else {
-    const std::size_t body = xml.find('>', xml.find("<ParameterList name=")) + 1;
-    xml.insert(body, element);
+  std::string origin = name + " with";
+  for (const auto& [key, value, type] : parameters) {
+    const std::string element = "<Parameter name=\"" + key + "\" type=\"" + type + "\" value=\"" + value + "\"/>";
+    if (const std::size_t old = xml.find("<Parameter name=\"" + key + "\""); old != std::string::npos) {
+      xml.replace(old, xml.find("/>", old) + 2 - old, element);
+    } else {
+      const std::size_t body = xml.find('>', xml.find("<ParameterList name=")) + 1;
+      xml.insert(body, element);
+    }
+    origin += " " + key + " = " + value;
   }
-  return linalg::SolverConfiguration::from_xml(xml, name + " with " + key + " = " + value);
+  return linalg::SolverConfiguration::from_xml(xml, origin);
+}
+// The same for one parameter `key` (a string unless `type` says otherwise).
+linalg::SolverConfiguration with_parameter(const std::string& name, const std::string& key, const std::string& value,
+                                           const std::string& type = "string") {
+  return with_parameters(name, {{key, value, type}});
 }
 
 // Random owned entries (ghosts imported), and the dot product over owned nodes.
@@ -318,16 +330,7 @@ TEST(SolverConfigurations, TheLeanCycleOnAOneLevelHierarchyIsMueLusCoarseSolver)
   // it is MueLu's one-level preconditioner, and CG takes its iterations exactly.
   const parallel::Communicator world(MPI_COMM_WORLD);
   auto one_level = [](const std::string& cycle) {
-    std::ifstream in(solver_file("gmg_lean_deflated_cg.xml"));
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string xml = text.str();
-    for (const auto& [key, value] : {std::pair<std::string, std::string>{"Coarsest nodes\" type=\"int\" value=\"", "100000000"},
-                                     {"Cycle\" type=\"string\" value=\"", cycle}}) {
-      const std::size_t at = xml.find(key) + key.size();
-      xml.replace(at, xml.find('"', at) - at, value);
-    }
-    return linalg::SolverConfiguration::from_xml(xml, "one level, Cycle = " + cycle);
+    return with_parameters("gmg_lean_deflated_cg.xml", {{"Coarsest nodes", "100000000", "int"}, {"Cycle", cycle}});
   };
   StiffSystem lean(one_level("lean"), world), muelu(one_level("MueLu"), world);
   lean.assemble(1.0 / 24.0);
@@ -399,15 +402,10 @@ TEST(SolverConfigurations, AChebyshevFineSmootherKeepsTheLeanCycleSpdAndBeatsAsM
   // gmg_lean_chebyshev_cg.xml (degree 5) must be SPD and converge as well.
   const parallel::Communicator world(MPI_COMM_WORLD);
   auto with_three = [](const std::string& smoother) {
-    std::ifstream in(solver_file("gmg_lean_deflated_cg.xml"));
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string xml = text.str();
-    const std::size_t body = xml.find('>', xml.find("<ParameterList name=")) + 1;
-    xml.insert(body, "<Parameter name=\"Fine sweeps\" type=\"int\" value=\"3\"/><Parameter name=\"Fine smoother\" "
-                     "type=\"string\" value=\"" + smoother + "\"/><Parameter name=\"Fine Chebyshev ratio\" "
-                     "type=\"double\" value=\"30\"/><Parameter name=\"Fine Chebyshev boost\" type=\"double\" value=\"1.3\"/>");
-    return linalg::SolverConfiguration::from_xml(xml, "Fine sweeps = 3, Fine smoother = " + smoother);
+    return with_parameters("gmg_lean_deflated_cg.xml", {{"Fine sweeps", "3", "int"},
+                                                        {"Fine smoother", smoother},
+                                                        {"Fine Chebyshev ratio", "30", "double"},
+                                                        {"Fine Chebyshev boost", "1.3", "double"}});
   };
   int iterations[2] = {0, 0};
   const char* smoothers[2] = {"sweeps", "Chebyshev"};
