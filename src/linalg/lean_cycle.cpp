@@ -4,6 +4,8 @@
 #include <MueLu_Utilities.hpp>
 #include <Teuchos_TimeMonitor.hpp>
 
+#include <optional>
+
 namespace viscompm::linalg {
 
 namespace {
@@ -42,9 +44,12 @@ void LeanCycle::apply(const multivector_type& X, multivector_type& Y, Teuchos::E
     smoother_->apply(residual, correction);
     x.update(1.0, correction, 1.0);
   };
-  // Chebyshev steps x += p(B A) B (X − A x) (Saad, Alg. 12.1), from x = 0 when `from_zero`.
-  multivector_type direction(A_->getDomainMap(), k);
+  // Chebyshev steps x += p(B A) B (X − A x) (Saad, Alg. 12.1), from x = 0 when `from_zero`; their
+  // search direction is allocated only for them (the sweeps' cycle stays as it was).
+  std::optional<multivector_type> chebyshev_direction;
+  if (smoothing_.chebyshev) chebyshev_direction.emplace(A_->getDomainMap(), k);
   const auto chebyshev = [&](bool from_zero) {
+    multivector_type& direction = *chebyshev_direction;
     const double upper = smoothing_.boost * smoother_->largest_eigenvalue(), lower = upper / smoothing_.ratio;
     const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
     double rho = 1.0 / sigma;

@@ -251,15 +251,14 @@ bool NewtonSolver::newton_direction_and_line_search(Step& step, const NodeVector
   // Once an exact H has failed as a step's first direction, later steps' first directions start
   // from the projected H (the step's start is where the exact H is indefinite, and its failed
   // attempt cost an assembly and a set-up); later directions of a step still try the exact H.
-  const bool first_direction = step.report.iterations == 1;
-  if (adaptive && first_direction && attempt.fresh && exact_failed_first_) attempt.project = true;
+  const bool step_start_fresh = adaptive && step.report.iterations == 1 && attempt.fresh;
+  if (step_start_fresh && exact_failed_first_) attempt.project = true;
   bool projected_with_kept_preconditioner = false;
   for (int k = 0; k < direction_attempts; ++k) {
     if (k > 0 && stop_requested(step)) return false;
     bool used_kept = false;
     const bool ok = try_newton_direction(step, rhs, tolerance, attempt, dv, used_kept);
-    if (k == 0 && adaptive && first_direction && attempt.fresh && !attempt.project && !abandoned_)
-      exact_failed_first_ = !ok;
+    if (k == 0 && step_start_fresh && !attempt.project && !abandoned_) exact_failed_first_ = !ok;
     if (ok) return true;
     if (abandoned_) return false;  // a solve out of the choice's budget: not a failure of the step
     if (used_kept && adaptive && attempt.fresh && !attempt.project && !projected_with_kept_preconditioner) {
